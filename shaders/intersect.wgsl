@@ -1,0 +1,105 @@
+// Ray-scene intersection (mirror: src/cpu/intersect.rs). Ray directions are unit length.
+
+const NO_HIT: f32 = 3.402823e38;
+
+struct Hit {
+    t: f32,
+    // Geometric normal, unit length, facing against the incoming ray.
+    normal: vec3<f32>,
+    material: u32,
+    // True when the ray hit the side the surface's outward normal points to.
+    front_face: bool,
+}
+
+// Nearest t > 0 of a sphere hit, or NO_HIT. The discriminant is r^2 - |oc - h d|^2 rather than
+// h^2 - c, which cancels catastrophically for small spheres far from the ray origin.
+fn hit_sphere(s: Sphere, ray: Ray) -> f32 {
+    let oc = s.center - ray.origin;
+    let h = dot(ray.dir, oc);
+    let perp = oc - h * ray.dir;
+    let r2 = s.radius * s.radius;
+    let disc = r2 - dot(perp, perp);
+    if disc < 0.0 {
+        return NO_HIT;
+    }
+    let c = dot(oc, oc) - r2;
+    // Roots of t^2 - 2 h t + c = 0 in the cancellation-free form: q and c / q.
+    let q = h + select(-1.0, 1.0, h >= 0.0) * sqrt(disc);
+    let t0 = min(q, c / q);
+    let t1 = max(q, c / q);
+    if t0 > 0.0 {
+        return t0;
+    }
+    if t1 > 0.0 {
+        return t1;
+    }
+    return NO_HIT;
+}
+
+// t of a quad hit, or NO_HIT: the plane, then 0 <= (u.w)/(u.u) <= 1 and 0 <= (v.w)/(v.v) <= 1
+// for the offset w of the hit point from the corner.
+fn hit_quad(q: Quad, ray: Ray) -> f32 {
+    let denom = dot(q.normal, ray.dir);
+    if abs(denom) < 1e-12 {
+        return NO_HIT;
+    }
+    let t = (q.plane_offset - dot(q.normal, ray.origin)) / denom;
+    if !(t > 0.0) {
+        return NO_HIT;
+    }
+    let w = ray.origin + t * ray.dir - q.corner;
+    let a = dot(q.u_dual, w);
+    let b = dot(q.v_dual, w);
+    if a < 0.0 || a > 1.0 || b < 0.0 || b > 1.0 {
+        return NO_HIT;
+    }
+    return t;
+}
+
+fn intersect_scene(ray: Ray) -> Hit {
+    var best_t = NO_HIT;
+    var best_index = 0u;
+    var best_is_sphere = false;
+    for (var i = 0u; i < params.sphere_count; i++) {
+        let t = hit_sphere(spheres[i], ray);
+        if t < best_t {
+            best_t = t;
+            best_index = i;
+            best_is_sphere = true;
+        }
+    }
+    for (var i = 0u; i < params.quad_count; i++) {
+        let t = hit_quad(quads[i], ray);
+        if t < best_t {
+            best_t = t;
+            best_index = i;
+            best_is_sphere = false;
+        }
+    }
+    var hit: Hit;
+    hit.t = best_t;
+    if best_t == NO_HIT {
+        return hit;
+    }
+    var outward: vec3<f32>;
+    if best_is_sphere {
+        let s = spheres[best_index];
+        outward = (ray.origin + best_t * ray.dir - s.center) / s.radius;
+        hit.material = s.material;
+    } else {
+        outward = quads[best_index].normal;
+        hit.material = quads[best_index].material;
+    }
+    hit.front_face = dot(outward, ray.dir) < 0.0;
+    hit.normal = select(-outward, outward, hit.front_face);
+    return hit;
+}
+
+// Moves a surface point off the surface along n, by a few ulps of its own magnitude, so the
+// next ray cannot hit the surface it leaves, at any scene scale (Wächter and Binder,
+// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019).
+fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let of_i = vec3<i32>(256.0 * n);
+    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
+    return select(p_i, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
+}

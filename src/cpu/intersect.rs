@@ -1,0 +1,134 @@
+//! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
+
+use super::Ray;
+use crate::shader_types::{Quad, Sphere};
+use glam::{BVec3, IVec3, Vec3};
+
+pub const NO_HIT: f32 = 3.402823e38;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f32,
+    /// Geometric normal, unit length, facing against the incoming ray.
+    pub normal: Vec3,
+    pub material: u32,
+    /// True when the ray hit the side the surface's outward normal points to.
+    pub front_face: bool,
+}
+
+/// Nearest t > 0 of a sphere hit, or `NO_HIT`. The discriminant is r² − |oc − h d|² rather
+/// than h² − c, which cancels catastrophically for small spheres far from the ray origin.
+pub fn hit_sphere(s: &Sphere, ray: &Ray) -> f32 {
+    let oc = Vec3::from(s.center) - ray.origin;
+    let h = ray.dir.dot(oc);
+    let perp = oc - h * ray.dir;
+    let r2 = s.radius * s.radius;
+    let disc = r2 - perp.dot(perp);
+    if disc < 0.0 {
+        return NO_HIT;
+    }
+    let c = oc.dot(oc) - r2;
+    // Roots of t² − 2ht + c = 0 in the cancellation-free form: q and c / q.
+    let q = h + if h >= 0.0 { 1.0 } else { -1.0 } * disc.sqrt();
+    let t0 = q.min(c / q);
+    let t1 = q.max(c / q);
+    if t0 > 0.0 {
+        return t0;
+    }
+    if t1 > 0.0 {
+        return t1;
+    }
+    NO_HIT
+}
+
+/// t of a quad hit, or `NO_HIT`: the plane, then 0 ≤ (u·w)/(u·u) ≤ 1 and 0 ≤ (v·w)/(v·v) ≤ 1
+/// for the offset w of the hit point from the corner.
+pub fn hit_quad(q: &Quad, ray: &Ray) -> f32 {
+    let normal = Vec3::from(q.normal);
+    let denom = normal.dot(ray.dir);
+    if denom.abs() < 1e-12 {
+        return NO_HIT;
+    }
+    let t = (q.plane_offset - normal.dot(ray.origin)) / denom;
+    // Written to reject NaN as the WGSL does.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(t > 0.0) {
+        return NO_HIT;
+    }
+    let w = ray.origin + t * ray.dir - Vec3::from(q.corner);
+    let a = Vec3::from(q.u_dual).dot(w);
+    let b = Vec3::from(q.v_dual).dot(w);
+    if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) {
+        return NO_HIT;
+    }
+    t
+}
+
+/// The nearest hit of `ray` among all spheres and quads; `t == NO_HIT` when there is none.
+pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
+    let mut best_t = NO_HIT;
+    let mut best_index = 0usize;
+    let mut best_is_sphere = false;
+    for (i, s) in spheres.iter().enumerate() {
+        let t = hit_sphere(s, ray);
+        if t < best_t {
+            best_t = t;
+            best_index = i;
+            best_is_sphere = true;
+        }
+    }
+    for (i, q) in quads.iter().enumerate() {
+        let t = hit_quad(q, ray);
+        if t < best_t {
+            best_t = t;
+            best_index = i;
+            best_is_sphere = false;
+        }
+    }
+    if best_t == NO_HIT {
+        return Hit {
+            t: NO_HIT,
+            normal: Vec3::ZERO,
+            material: 0,
+            front_face: false,
+        };
+    }
+    let (outward, material) = if best_is_sphere {
+        let s = &spheres[best_index];
+        (
+            (ray.origin + best_t * ray.dir - Vec3::from(s.center)) / s.radius,
+            s.material,
+        )
+    } else {
+        let q = &quads[best_index];
+        (Vec3::from(q.normal), q.material)
+    };
+    let front_face = outward.dot(ray.dir) < 0.0;
+    Hit {
+        t: best_t,
+        normal: if front_face { outward } else { -outward },
+        material,
+        front_face,
+    }
+}
+
+/// Moves a surface point off the surface along `n`, by a few ulps of its own magnitude, so the
+/// next ray cannot hit the surface it leaves, at any scene scale (Wächter and Binder,
+/// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019).
+pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
+    let of_i = (256.0 * n).as_ivec3();
+    let bits = IVec3::new(
+        p.x.to_bits() as i32,
+        p.y.to_bits() as i32,
+        p.z.to_bits() as i32,
+    );
+    let step = IVec3::select(p.cmplt(Vec3::ZERO), -of_i, of_i);
+    let moved = bits.wrapping_add(step);
+    let p_i = Vec3::new(
+        f32::from_bits(moved.x as u32),
+        f32::from_bits(moved.y as u32),
+        f32::from_bits(moved.z as u32),
+    );
+    let near_origin: BVec3 = p.abs().cmplt(Vec3::splat(1.0 / 32.0));
+    Vec3::select(near_origin, p + (1.0 / 65536.0) * n, p_i)
+}

@@ -1,0 +1,18 @@
+//! The CPU reference: the kernel's algorithm in Rust, one file per WGSL file, with the same
+//! names, the same random stream and the same f32 operations. It is the oracle for the GPU
+//! and the fallback where there is no Vulkan device.
+
+pub mod camera;
+pub mod intersect;
+pub mod material;
+pub mod renderer;
+pub mod rng;
+pub mod trace;
+
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+}

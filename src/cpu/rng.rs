@@ -1,0 +1,32 @@
+//! Counter-based random numbers (WGSL side: `shaders/rng.wgsl`), bit for bit.
+//! Stream 0 is the camera; stream `b + 1` is the scattering at bounce `b`.
+
+pub fn pcg_hash(v: u32) -> u32 {
+    let state = v.wrapping_mul(747796405).wrapping_add(2891336453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277803737);
+    (word >> 22) ^ word
+}
+
+/// A PCG stream for one (pixel, sample, stream, seed).
+#[derive(Clone, Debug)]
+pub struct Rng {
+    state: u32,
+}
+
+impl Rng {
+    pub fn new(pixel: u32, sample: u32, stream: u32, seed: u32) -> Self {
+        let state = pcg_hash(pixel.wrapping_add(pcg_hash(
+            sample.wrapping_add(pcg_hash(stream.wrapping_add(pcg_hash(seed)))),
+        )));
+        Rng { state }
+    }
+
+    /// Uniform in [0, 1), from the top 24 bits so the conversion to f32 is exact.
+    pub fn next_f32(&mut self) -> f32 {
+        self.state = self.state.wrapping_mul(747796405).wrapping_add(2891336453);
+        let s = self.state;
+        let word = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277803737);
+        let bits = (word >> 22) ^ word;
+        (bits >> 8) as f32 * (1.0 / 16777216.0)
+    }
+}
