@@ -1,0 +1,47 @@
+//! The `glint` command line.
+
+mod render;
+
+use crate::error::InputError;
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "glint",
+    version,
+    about = "A physically based GPU path tracer (Vulkan via wgpu)"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene file to a PNG or EXR image.
+    Render(render::RenderArgs),
+}
+
+/// Runs the command line; exit code 0 done, 2 bad input (scene or flags), 1 anything else.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // clap exits with 2 on bad flags and 0 for --help and --version.
+        Err(e) => e.exit(),
+    };
+    let result = match cli.command {
+        Command::Render(args) => render::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("glint: error: {e:#}");
+            if e.downcast_ref::<InputError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}

@@ -1,0 +1,186 @@
+//! `glint render`.
+
+use crate::cpu::renderer::CpuRenderer;
+use crate::error::InputError;
+use crate::gpu::{GpuContext, GpuRenderer};
+use crate::output::ImageFormat;
+use crate::render::{mean_image, render_progressive, BatchSizer, Renderer};
+use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use anyhow::{Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// How often the output file is refreshed with the running image.
+const CHECKPOINT_INTERVAL: Duration = Duration::from_secs(3);
+/// Wanted duration of one GPU submission: short enough for a desktop GPU's watchdog and a
+/// responsive progress bar, long enough that per-batch overhead stays small.
+const BATCH_TARGET: Duration = Duration::from_millis(250);
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Output image: .png (clamped, sRGB) or .exr (linear float32 radiance). Default: <scene stem>.png
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Samples per pixel (overrides [render] spp).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_SPP as i64), allow_negative_numbers = true)]
+    pub spp: Option<u32>,
+    /// Image width in pixels (overrides [render] width).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64), allow_negative_numbers = true)]
+    pub width: Option<u32>,
+    /// Image height in pixels (overrides [render] height).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64), allow_negative_numbers = true)]
+    pub height: Option<u32>,
+    /// Scattering events per path (overrides [render] max_bounces).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=MAX_BOUNCES_LIMIT as i64), allow_negative_numbers = true)]
+    pub max_bounces: Option<u32>,
+    /// Random seed (overrides [render] seed).
+    #[arg(long, allow_negative_numbers = true)]
+    pub seed: Option<u32>,
+    /// Render on the CPU reference.
+    #[arg(long, conflicts_with = "gpu")]
+    pub cpu: bool,
+    /// Render on a Vulkan GPU or fail; without it, no GPU means a CPU render.
+    #[arg(long)]
+    pub gpu: bool,
+    /// Stop at the first batch boundary after this many seconds and write what is done.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    pub time_limit: Option<f64>,
+    /// Print a JSON summary on stdout at the end. Its "seconds" is the time spent rendering
+    /// batches only: start-up, scene upload, shader compilation and file writes are not in it
+    /// ("wall_seconds" is the whole command).
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number of seconds"))?;
+    if !v.is_finite() || v < 0.0 {
+        return Err(format!("must be a finite number ≥ 0, got {s}"));
+    }
+    Ok(v)
+}
+
+fn default_output(scene: &Path) -> PathBuf {
+    let stem = scene.file_stem().unwrap_or_else(|| "render".as_ref());
+    PathBuf::from(stem).with_extension("png")
+}
+
+/// Either a GPU renderer or, where there is none, the CPU reference.
+fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
+    if args.cpu {
+        return Ok(None);
+    }
+    match GpuContext::new() {
+        Ok(ctx) => Ok(Some(ctx)),
+        Err(e) if args.gpu => Err(anyhow::Error::new(e).context("--gpu was given")),
+        Err(e) => {
+            eprintln!("glint: {e}; rendering on the CPU reference instead");
+            Ok(None)
+        }
+    }
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let started = Instant::now();
+    let scene = Scene::load(&args.scene).map_err(InputError::from)?;
+    let overrides = RenderOverrides {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_bounces: args.max_bounces,
+        seed: args.seed,
+    };
+    let scene = scene
+        .with_overrides(&overrides)
+        .map_err(|m| InputError(format!("{}: {m}", args.scene.display())))?;
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.scene));
+    ImageFormat::from_path(&output).map_err(InputError)?;
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(InputError(format!(
+                "{}: the output folder {} does not exist",
+                output.display(),
+                dir.display()
+            ))
+            .into());
+        }
+    }
+
+    let kernel_scene = scene.kernel_scene();
+    let gpu = open_gpu(&args)?;
+    let mut renderer: Box<dyn Renderer + '_> = match &gpu {
+        Some(ctx) => Box::new(GpuRenderer::new(ctx, &kernel_scene)?),
+        None => Box::new(CpuRenderer::new(&kernel_scene)),
+    };
+
+    let settings = &scene.render;
+    let (width, height) = (settings.width, settings.height);
+    let progress = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(settings.spp as u64), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    progress.set_style(
+        ProgressStyle::with_template("{bar:40.cyan/blue} {pos}/{len} spp  {msg}  ETA {eta}")
+            .expect("valid template"),
+    );
+    let pixels = width as f64 * height as f64;
+    let mut last_checkpoint = Instant::now();
+    let mut sizer = BatchSizer::new(BATCH_TARGET);
+    let stats = render_progressive(
+        renderer.as_mut(),
+        settings.spp,
+        args.time_limit.map(Duration::from_secs_f64),
+        &mut sizer,
+        |r, report| {
+            progress.set_position(report.spp_done as u64);
+            let rate = report.last_batch_spp as f64 * pixels / report.last_batch_time.as_secs_f64();
+            progress.set_message(format!("{:.2} M samples/s", rate / 1e6));
+            if report.spp_done < report.spp_target
+                && last_checkpoint.elapsed() >= CHECKPOINT_INTERVAL
+            {
+                mean_image(width, height, &r.read_sums()?, report.spp_done).write(&output)?;
+                last_checkpoint = Instant::now();
+            }
+            Ok(())
+        },
+    )?;
+    progress.finish_and_clear();
+    let image = mean_image(width, height, &renderer.read_sums()?, stats.spp);
+    image
+        .write(&output)
+        .with_context(|| format!("writing {}", output.display()))?;
+
+    if args.json {
+        let seconds = stats.render_time.as_secs_f64();
+        let paths = pixels as u64 * stats.spp as u64;
+        let summary = serde_json::json!({
+            "scene": args.scene.display().to_string(),
+            "output": output.display().to_string(),
+            "width": width,
+            "height": height,
+            "spp": stats.spp,
+            "max_bounces": settings.max_bounces,
+            "seed": settings.seed,
+            "paths": paths,
+            "seconds": seconds,
+            "paths_per_second": paths as f64 / seconds.max(1e-9),
+            "wall_seconds": started.elapsed().as_secs_f64(),
+            "stopped_by": stats.stop_reason.as_str(),
+            "device": renderer.device_name(),
+            "backend": renderer.backend_name(),
+        });
+        println!("{summary}");
+    }
+    Ok(())
+}

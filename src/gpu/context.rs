@@ -1,0 +1,100 @@
+//! The Vulkan device glint renders on.
+
+use std::sync::{Arc, Mutex};
+
+/// Why no GPU could be used.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct GpuUnavailable(pub String);
+
+/// A Vulkan device and its queue, with the errors wgpu reports asynchronously.
+pub struct GpuContext {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub adapter_info: wgpu::AdapterInfo,
+    pub features: wgpu::Features,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl GpuContext {
+    /// Opens the first Vulkan adapter (high performance preferred). Only Vulkan is enabled:
+    /// with every backend on, a machine without a Vulkan driver silently gets an OpenGL
+    /// adapter whose output differs.
+    pub fn new() -> Result<GpuContext, GpuUnavailable> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::VULKAN;
+        desc.flags = wgpu::InstanceFlags::empty().with_env();
+        Self::with_instance(&wgpu::Instance::new(desc), None)
+    }
+
+    /// Opens a device on `instance`, able to present to `surface` when one is given.
+    pub fn with_instance(
+        instance: &wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<GpuContext, GpuUnavailable> {
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            compatible_surface: surface,
+            ..Default::default()
+        }))
+        .map_err(|e| GpuUnavailable(format!("no Vulkan device found ({e})")))?;
+        let adapter_info = adapter.get_info();
+        if adapter_info.backend != wgpu::Backend::Vulkan {
+            return Err(GpuUnavailable(format!(
+                "adapter {} uses {:?}, not Vulkan",
+                adapter_info.name, adapter_info.backend
+            )));
+        }
+        // wgpu's default limits are below what lavapipe and desktop GPUs offer (e.g. the
+        // 128 MiB storage binding the accumulation buffer may need): ask for the adapter's own.
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("glint"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| GpuUnavailable(format!("cannot open {}: {e}", adapter_info.name)))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        // wgpu's default handler panics; a render reports the error instead.
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().unwrap().push(e.to_string());
+        }));
+        Ok(GpuContext {
+            device,
+            queue,
+            adapter_info,
+            features,
+            errors,
+        })
+    }
+
+    /// The first error the device reported since the last call, if any.
+    pub fn take_error(&self) -> Option<String> {
+        let mut errors = self.errors.lock().unwrap();
+        let first = errors.first().cloned();
+        errors.clear();
+        first
+    }
+
+    /// e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
+    pub fn device_name(&self) -> String {
+        self.adapter_info.name.clone()
+    }
+
+    pub fn backend_name(&self) -> String {
+        format!("{:?}", self.adapter_info.backend).to_lowercase()
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait_idle(&self) -> anyhow::Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| anyhow::anyhow!("GPU wait failed: {e}"))?;
+        match self.take_error() {
+            Some(e) => Err(anyhow::anyhow!("GPU error: {e}")),
+            None => Ok(()),
+        }
+    }
+}

@@ -1,0 +1,7 @@
+//! The GPU path: wgpu on Vulkan, running the WGSL kernel in `shaders/`.
+
+pub mod context;
+pub mod renderer;
+
+pub use context::{GpuContext, GpuUnavailable};
+pub use renderer::GpuRenderer;

@@ -1,0 +1,182 @@
+//! The GPU renderer: scene upload, sample batches, readback of the running sums.
+
+use super::context::GpuContext;
+use crate::render::Renderer;
+use crate::scene::KernelScene;
+use crate::shader::{render_kernel_source, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
+use crate::shader_types::Params;
+use anyhow::{anyhow, Result};
+use bytemuck::Pod;
+use wgpu::util::DeviceExt;
+
+pub struct GpuRenderer<'a> {
+    ctx: &'a GpuContext,
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    params: Params,
+    params_buffer: wgpu::Buffer,
+    accum_buffer: wgpu::Buffer,
+    readback_buffer: wgpu::Buffer,
+}
+
+/// A read-only storage buffer holding `items`; bindings cannot be empty, so an empty list
+/// uploads one zeroed element (the kernel reads the real count from `Params`).
+fn storage_buffer<T: Pod + Default>(ctx: &GpuContext, label: &str, items: &[T]) -> wgpu::Buffer {
+    let placeholder = [T::default()];
+    let items = if items.is_empty() {
+        &placeholder[..]
+    } else {
+        items
+    };
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(items),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+}
+
+impl<'a> GpuRenderer<'a> {
+    pub fn new(ctx: &'a GpuContext, scene: &KernelScene) -> Result<GpuRenderer<'a>> {
+        let device = &ctx.device;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("glint render kernel"),
+            source: wgpu::ShaderSource::Wgsl(render_kernel_source().into()),
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("glint render"),
+            layout: None,
+            module: &module,
+            entry_point: Some(RENDER_ENTRY_POINT),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let params = scene.params;
+        let pixel_count = params.width as u64 * params.height as u64;
+        let accum_size = pixel_count * 16;
+        let max_binding = device.limits().max_storage_buffer_binding_size;
+        if accum_size > max_binding {
+            return Err(anyhow!(
+                "a {}×{} image needs a {} MiB accumulation buffer; this device binds at most {} MiB",
+                params.width,
+                params.height,
+                accum_size >> 20,
+                max_binding >> 20
+            ));
+        }
+        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
+        let quads = storage_buffer(ctx, "quads", &scene.quads);
+        let materials = storage_buffer(ctx, "materials", &scene.materials);
+        let accum_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accum"),
+            size: accum_size,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let readback_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: accum_size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                (0, &params_buffer),
+                (1, &spheres),
+                (2, &quads),
+                (3, &materials),
+                (4, &accum_buffer),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+        ctx.wait_idle()?;
+        Ok(GpuRenderer {
+            ctx,
+            pipeline,
+            bind_group,
+            params,
+            params_buffer,
+            accum_buffer,
+            readback_buffer,
+        })
+    }
+}
+
+impl Renderer for GpuRenderer<'_> {
+    fn add_samples(&mut self, sample_start: u32, sample_count: u32) -> Result<()> {
+        self.params.sample_start = sample_start;
+        self.params.sample_count = sample_count;
+        self.ctx
+            .queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("render"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(
+                self.params.width.div_ceil(WORKGROUP_SIZE.0),
+                self.params.height.div_ceil(WORKGROUP_SIZE.1),
+                1,
+            );
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+        self.ctx.wait_idle()
+    }
+
+    fn read_sums(&mut self) -> Result<Vec<[f32; 3]>> {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.accum_buffer, 0, &self.readback_buffer, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        let slice = self.readback_buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.ctx.wait_idle()?;
+        rx.recv()
+            .map_err(|_| anyhow!("GPU readback was dropped"))?
+            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+        let sums = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+            bytemuck::cast_slice::<u8, [f32; 4]>(&view)
+                .iter()
+                .map(|p| [p[0], p[1], p[2]])
+                .collect()
+        };
+        self.readback_buffer.unmap();
+        Ok(sums)
+    }
+
+    fn reset(&mut self) -> Result<()> {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&self.accum_buffer, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.ctx.wait_idle()
+    }
+
+    fn device_name(&self) -> String {
+        self.ctx.device_name()
+    }
+
+    fn backend_name(&self) -> String {
+        self.ctx.backend_name()
+    }
+}

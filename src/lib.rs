@@ -1,0 +1,15 @@
+//! glint: a physically based path tracer on the GPU (wgpu, Vulkan, WGSL compute shaders), with a
+//! CPU reference that mirrors the kernel operation for operation.
+//!
+//! Data flows one way: scene file → [`scene::Scene`] (validated) → [`scene::KernelScene`]
+//! (the kernel's structs) → a [`render::Renderer`] (GPU or CPU) → [`output::Image`].
+
+pub mod cli;
+pub mod cpu;
+pub mod error;
+pub mod gpu;
+pub mod output;
+pub mod render;
+pub mod scene;
+pub mod shader;
+pub mod shader_types;
