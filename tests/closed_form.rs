@@ -1,0 +1,207 @@
+//! Scenes whose images are known in closed form, rendered on the CPU reference and on the GPU.
+
+mod common;
+use common::{kernel_scene, render_both};
+
+const FURNACE: &str = r#"
+[camera]
+eye = [0.0, 0.0, 0.0]
+target = [0.3, 0.2, 1.0]
+up = [0.0, 1.0, 0.0]
+vfov = 100.0
+[render]
+width = 32
+height = 24
+spp = 4
+max_bounces = BOUNCES
+[materials.furnace]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+emission = [1.0, 1.0, 1.0]
+strength = 0.5
+[[spheres]]
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "furnace"
+"#;
+
+/// Camera inside a sphere that reflects half and emits 0.5: a path with B scattering events
+/// gathers 0.5 + 0.25 + … + 0.5^(B+1) = 1 − 2^−(B+1), whatever directions it takes. There is
+/// no variance at all, so the tolerance is f32 rounding; a wrong albedo factor, emission
+/// weight or bounce count is off by at least 2^−(B+1).
+#[test]
+fn furnace_is_one_minus_two_to_the_minus_bounces_plus_one() {
+    for bounces in [0u32, 1, 8, 30] {
+        let scene = kernel_scene(&FURNACE.replace("BOUNCES", &bounces.to_string()));
+        let expected = 1.0 - 0.5f64.powi(bounces as i32 + 1);
+        for (device, image) in render_both(&scene, 4) {
+            for (i, p) in image.pixels.iter().enumerate() {
+                for c in p {
+                    assert!(
+                        (*c as f64 - expected).abs() < 1e-6,
+                        "{device}, B = {bounces}, pixel {i}: {c} vs {expected}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The furnace scene shipped in scenes/ is 1 everywhere (to f32 precision).
+#[test]
+fn shipped_furnace_scene_is_one() {
+    let scene = common::scene(
+        &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/furnace.toml"))
+            .unwrap(),
+    )
+    .kernel_scene();
+    for (device, image) in render_both(&scene, 2) {
+        for p in &image.pixels {
+            for c in p {
+                assert!((c - 1.0).abs() < 1e-6, "{device}: {c}");
+            }
+        }
+    }
+}
+
+const WHITE_SPHERE: &str = r#"
+[camera]
+eye = [CX, CY, CZ]
+target = [SX, SY, SZ]
+up = [0.0, 1.0, 0.0]
+vfov = 30.0
+[render]
+width = 32
+height = 32
+spp = 4
+max_bounces = BOUNCES
+background = [1.0, 1.0, 1.0]
+[materials.white]
+type = "diffuse"
+color = [1.0, 1.0, 1.0]
+[[spheres]]
+center = [SX, SY, SZ]
+radius = R
+material = "white"
+"#;
+
+fn white_sphere(center: [f32; 3], radius: f32, bounces: u32) -> glint::scene::KernelScene {
+    let eye = [center[0], center[1], center[2] - 4.0 * radius];
+    let mut text = WHITE_SPHERE
+        .replace("BOUNCES", &bounces.to_string())
+        .replace("R", &radius.to_string());
+    for (name, v) in [
+        ("CX", eye[0]),
+        ("CY", eye[1]),
+        ("CZ", eye[2]),
+        ("SX", center[0]),
+        ("SY", center[1]),
+        ("SZ", center[2]),
+    ] {
+        text = text.replace(name, &format!("{v:?}"));
+    }
+    kernel_scene(&text)
+}
+
+/// A white (albedo 1) convex diffuse object under a uniform white sky vanishes: every bounce
+/// off it leaves it and sees the sky, with weight exactly 1. With max_bounces = 1 a ray that
+/// re-hit the surface it left would end at the bounce cap and return 0, so this also proves
+/// there is no self-intersection, at the Cornell box's scale and for a 0.01-unit sphere far
+/// from the origin.
+#[test]
+fn white_sphere_under_white_sky_vanishes_at_every_scale() {
+    for (center, radius) in [
+        ([0.0, 0.0, 0.0], 1.0),
+        ([278.0, 90.0, 190.0], 90.0),
+        ([1000.0, 500.0, -300.0], 0.01),
+    ] {
+        let scene = white_sphere(center, radius, 1);
+        for (device, image) in render_both(&scene, 4) {
+            let worst = image
+                .pixels
+                .iter()
+                .flatten()
+                .map(|c| (c - 1.0).abs())
+                .fold(0.0, f32::max);
+            assert!(
+                worst < 1e-6,
+                "{device}, sphere r = {radius} at {center:?}: off by {worst}"
+            );
+        }
+    }
+}
+
+/// With max_bounces = 0 only emitters (and the sky) are seen: a sample is 1 where it sees the
+/// sky and 0 on the unlit sphere, so with 4 samples every pixel is exactly k/4. Ignoring the
+/// cap would make the white sphere scatter the sky and vanish (no black pixels).
+#[test]
+fn zero_bounces_sees_only_emitters() {
+    let scene = white_sphere([0.0, 0.0, 0.0], 1.0, 0);
+    for (device, image) in render_both(&scene, 4) {
+        for p in &image.pixels {
+            assert!((p[0] * 4.0).fract() == 0.0, "{device}: {p:?} is not k/4");
+        }
+        let black = image.pixels.iter().filter(|p| p[0] == 0.0).count();
+        let white = image.pixels.iter().filter(|p| p[0] == 1.0).count();
+        assert!(
+            black > 100 && white > 100,
+            "{device}: {black} black, {white} white"
+        );
+    }
+}
+
+/// A diffuse floor of albedo ρ below an emitting sphere (radiance L, radius r, centre at height
+/// d), with one bounce: the floor's radiance is ρ/π · E with irradiance E = π L (r/d)², so
+/// ρ L (r/d)². This checks the cosine weighting: sampling the hemisphere uniformly instead
+/// gives ρ L (1 − √(1 − (r/d)²)) = 0.54× the right value for r/d = 1/2.
+///
+/// Each camera path is ρL with probability p = (r/d)² and 0 otherwise, so over N paths the
+/// mean has standard deviation ρL √(p(1 − p)/N). With N = 48·48·64 = 147456 that is 0.45% of
+/// the mean; the tolerance is 5σ (2.3%). The narrow field of view keeps the pixels within
+/// 0.05 units of the point below the sphere, where E varies by < 0.1%.
+#[test]
+fn floor_under_an_emitting_sphere_matches_the_irradiance_formula() {
+    let scene = kernel_scene(
+        r#"
+[camera]
+eye = [0.0, 5.0, -8.660254]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 0.5
+[render]
+width = 48
+height = 48
+spp = 64
+max_bounces = 1
+seed = 11
+[materials.floor]
+type = "diffuse"
+color = [0.6, 0.6, 0.6]
+[materials.lamp]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+strength = 4.0
+[[quads]]
+corner = [-100.0, 0.0, -100.0]
+u = [200.0, 0.0, 0.0]
+v = [0.0, 0.0, 200.0]
+material = "floor"
+[[spheres]]
+center = [0.0, 2.0, 0.0]
+radius = 1.0
+material = "lamp"
+"#,
+    );
+    let (rho, l, p) = (0.6f64, 4.0f64, 0.25f64);
+    let expected = rho * l * p;
+    let n = 48.0 * 48.0 * 64.0;
+    let sigma = rho * l * (p * (1.0 - p) / n).sqrt();
+    for (device, image) in render_both(&scene, 64) {
+        let mean = image.mean();
+        assert!(
+            (mean - expected).abs() < 5.0 * sigma,
+            "{device}: {mean} vs {expected} ± {sigma}"
+        );
+    }
+}

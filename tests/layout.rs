@@ -1,0 +1,142 @@
+//! The kernel is valid WGSL, and the Rust structs in src/shader_types.rs match the WGSL ones
+//! byte for byte (naga's layouter), so the host and the kernel cannot drift apart.
+
+use glint::shader::{render_kernel_source, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
+use glint::shader_types::{Material, Params, Quad, Sphere};
+use naga::proc::Layouter;
+use std::mem::{offset_of, size_of};
+
+fn parse_and_validate() -> naga::Module {
+    let source = render_kernel_source();
+    let module = naga::front::wgsl::parse_str(&source)
+        .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
+    module
+}
+
+#[test]
+fn kernel_validates_and_has_the_render_entry_point() {
+    let module = parse_and_validate();
+    let entry = module
+        .entry_points
+        .iter()
+        .find(|e| e.name == RENDER_ENTRY_POINT)
+        .expect("render entry point");
+    assert_eq!(entry.stage, naga::ShaderStage::Compute);
+    assert_eq!(
+        entry.workgroup_size,
+        [WORKGROUP_SIZE.0, WORKGROUP_SIZE.1, 1]
+    );
+}
+
+/// Offsets of every member and the size of a WGSL struct, from naga's layouter.
+fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
+    let mut layouter = Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no WGSL struct {name}"));
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        panic!("{name} is not a struct");
+    };
+    let fields = members
+        .iter()
+        .map(|m| (m.name.clone().unwrap(), m.offset))
+        .collect();
+    (fields, layouter[handle].size)
+}
+
+/// Asserts a Rust struct has the WGSL struct's size and, for every WGSL member, a field of the
+/// same name at the same offset. Rust-only padding fields (leading `_`) are not in the WGSL.
+macro_rules! assert_same_layout {
+    ($module:expr, $rust:ty, $wgsl:literal, [$($field:ident),* $(,)?]) => {{
+        let (wgsl_fields, wgsl_size) = wgsl_layout($module, $wgsl);
+        let rust_fields: Vec<(String, u32)> =
+            vec![$((stringify!($field).to_string(), offset_of!($rust, $field) as u32)),*];
+        assert_eq!(rust_fields, wgsl_fields, "member offsets of {}", $wgsl);
+        assert_eq!(size_of::<$rust>() as u32, wgsl_size, "size of {}", $wgsl);
+    }};
+}
+
+#[test]
+fn rust_structs_match_wgsl_layout() {
+    let module = parse_and_validate();
+    assert_same_layout!(
+        &module,
+        Params,
+        "Params",
+        [
+            eye,
+            width,
+            forward,
+            height,
+            right,
+            sample_start,
+            up,
+            sample_count,
+            background,
+            max_bounces,
+            seed,
+            sphere_count,
+            quad_count,
+            material_count
+        ]
+    );
+    assert_same_layout!(&module, Sphere, "Sphere", [center, radius, material]);
+    assert_same_layout!(
+        &module,
+        Quad,
+        "Quad",
+        [
+            corner,
+            material,
+            edge_u,
+            area,
+            edge_v,
+            plane_offset,
+            normal,
+            pad0,
+            u_dual,
+            pad1,
+            v_dual,
+            pad2
+        ]
+    );
+    assert_same_layout!(
+        &module,
+        Material,
+        "Material",
+        [albedo, kind, emission, pad0]
+    );
+}
+
+#[test]
+fn material_kind_constants_match() {
+    let module = parse_and_validate();
+    let constant = |name: &str| {
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("no WGSL constant {name}"));
+        match module.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("{name} is {e:?}"),
+        }
+    };
+    assert_eq!(
+        constant("MATERIAL_DIFFUSE"),
+        glint::shader_types::MATERIAL_DIFFUSE
+    );
+    assert_eq!(
+        constant("MATERIAL_SPECULAR"),
+        glint::shader_types::MATERIAL_SPECULAR
+    );
+}
