@@ -39,9 +39,21 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pixel = id.y * params.width + id.x;
-    var sum = vec3<f32>(0.0);
+    // Welford over this batch's samples...
+    var mean = vec3<f32>(0.0);
+    var m2 = vec3<f32>(0.0);
     for (var i = 0u; i < params.sample_count; i++) {
-        sum += trace_path(pixel, id.x, id.y, params.sample_start + i);
+        let x = trace_path(pixel, id.x, id.y, params.sample_start + i);
+        let delta = x - mean;
+        mean += delta / f32(i + 1u);
+        m2 += delta * (x - mean);
     }
-    accum[pixel] += vec4<f32>(sum, 0.0);
+    // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
+    let n_old = f32(params.sample_start);
+    let n_new = f32(params.sample_count);
+    let n = n_old + n_new;
+    let old_mean = accum_mean[pixel].xyz;
+    let delta = mean - old_mean;
+    accum_mean[pixel] = vec4<f32>(old_mean + delta * (n_new / n), 0.0);
+    accum_m2[pixel] = vec4<f32>(accum_m2[pixel].xyz + m2 + delta * delta * (n_old * n_new / n), 0.0);
 }

@@ -9,6 +9,7 @@ struct Params {
     height: u32,
     // Image-right and image-up, scaled to half the viewport at unit distance.
     right: vec3<f32>,
+    // Samples already in the accumulators: the global index of this batch's first sample.
     sample_start: u32,
     up: vec3<f32>,
     sample_count: u32,
@@ -63,5 +64,8 @@ struct Ray {
 @group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
 @group(0) @binding(2) var<storage, read> quads: array<Quad>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
-// Per pixel: running sum of sample radiance in xyz; w unused.
-@group(0) @binding(4) var<storage, read_write> accum: array<vec4<f32>>;
+// Per pixel, over all samples so far: the mean radiance (xyz; w unused) and M2, the sum of
+// squared deviations from the mean (xyz), from which the variance follows. Running means and
+// M2 stay accurate in f32 over millions of samples, where sums of squares would cancel.
+@group(0) @binding(4) var<storage, read_write> accum_mean: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> accum_m2: array<vec4<f32>>;

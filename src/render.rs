@@ -6,13 +6,18 @@ use crate::output::Image;
 use anyhow::Result;
 use std::time::{Duration, Instant};
 
-/// A device that accumulates per-pixel radiance sums.
+/// A device that accumulates per-pixel radiance statistics.
 pub trait Renderer {
-    /// Adds `sample_count` samples to every pixel, with global sample indices starting at
-    /// `sample_start` (the random stream depends on the index, never on the batching).
-    fn add_samples(&mut self, sample_start: u32, sample_count: u32) -> Result<()>;
-    /// The per-pixel radiance sums so far.
-    fn read_sums(&mut self) -> Result<Vec<[f32; 3]>>;
+    /// Adds `count` samples to every pixel. Their global sample indices continue from
+    /// [`Renderer::samples`], and the random stream depends on the index, never on the batching.
+    fn add_samples(&mut self, count: u32) -> Result<()>;
+    /// Samples per pixel accumulated so far.
+    fn samples(&self) -> u32;
+    /// The mean radiance per pixel.
+    fn read_mean(&mut self) -> Result<Image>;
+    /// The variance of each pixel's mean estimate (σ²/n per channel, from the unbiased sample
+    /// variance); zero before two samples.
+    fn read_variance(&mut self) -> Result<Image>;
     /// Forgets all samples.
     fn reset(&mut self) -> Result<()>;
     /// Adapter name, or "cpu".
@@ -20,14 +25,13 @@ pub trait Renderer {
     fn backend_name(&self) -> String;
 }
 
-/// The mean radiance image from per-pixel sums of `spp` samples.
-pub fn mean_image(width: u32, height: u32, sums: &[[f32; 3]], spp: u32) -> Image {
-    let scale = 1.0 / spp.max(1) as f32;
-    Image {
-        width,
-        height,
-        pixels: sums.iter().map(|s| s.map(|c| c * scale)).collect(),
+/// σ²/n per channel from M2 over n samples: M2 / (n − 1) / n.
+pub fn variance_of_mean(m2: [f32; 3], n: u32) -> [f32; 3] {
+    if n < 2 {
+        return [0.0; 3];
     }
+    let scale = 1.0 / ((n as f64 - 1.0) * n as f64);
+    m2.map(|v| (v.max(0.0) as f64 * scale) as f32)
 }
 
 /// Picks the next batch's samples per pixel from the last batch's duration.
@@ -105,16 +109,15 @@ pub fn render_progressive(
     mut after_batch: impl FnMut(&mut dyn Renderer, &BatchReport) -> Result<()>,
 ) -> Result<RenderStats> {
     let started = Instant::now();
-    let mut spp_done = 0u32;
     let mut render_time = Duration::ZERO;
     let mut stop_reason = StopReason::SamplesReached;
-    while spp_done < spp {
-        let count = sizer.spp_per_batch.min(spp - spp_done);
+    while renderer.samples() < spp {
+        let count = sizer.spp_per_batch.min(spp - renderer.samples());
         let batch_start = Instant::now();
-        renderer.add_samples(spp_done, count)?;
+        renderer.add_samples(count)?;
         let took = batch_start.elapsed();
         render_time += took;
-        spp_done += count;
+        let spp_done = renderer.samples();
         sizer.update(count, took);
         after_batch(
             renderer,
@@ -132,26 +135,17 @@ pub fn render_progressive(
         }
     }
     Ok(RenderStats {
-        spp: spp_done,
+        spp: renderer.samples(),
         render_time,
         stop_reason,
     })
 }
 
-/// Renders exactly `spp` samples in batches of `batch` and returns the mean image: the simple
-/// path for tests and tools that want no progress reporting.
-pub fn render_image(
-    renderer: &mut dyn Renderer,
-    width: u32,
-    height: u32,
-    spp: u32,
-    batch: u32,
-) -> Result<Image> {
-    let mut done = 0;
-    while done < spp {
-        let count = batch.max(1).min(spp - done);
-        renderer.add_samples(done, count)?;
-        done += count;
+/// Adds samples until there are `spp`, in batches of `batch`, and returns the mean image: the
+/// simple path for tests and tools that want no progress reporting.
+pub fn render_image(renderer: &mut dyn Renderer, spp: u32, batch: u32) -> Result<Image> {
+    while renderer.samples() < spp {
+        renderer.add_samples(batch.max(1).min(spp - renderer.samples()))?;
     }
-    Ok(mean_image(width, height, &renderer.read_sums()?, spp))
+    renderer.read_mean()
 }

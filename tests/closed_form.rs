@@ -132,14 +132,16 @@ fn white_sphere_under_white_sky_vanishes_at_every_scale() {
 }
 
 /// With max_bounces = 0 only emitters (and the sky) are seen: a sample is 1 where it sees the
-/// sky and 0 on the unlit sphere, so with 4 samples every pixel is exactly k/4. Ignoring the
+/// sky and 0 on the unlit sphere, so with 4 samples every pixel is k/4 (up to the f32 rounding
+/// of the running mean). Ignoring the
 /// cap would make the white sphere scatter the sky and vanish (no black pixels).
 #[test]
 fn zero_bounces_sees_only_emitters() {
     let scene = white_sphere([0.0, 0.0, 0.0], 1.0, 0);
     for (device, image) in render_both(&scene, 4) {
         for p in &image.pixels {
-            assert!((p[0] * 4.0).fract() == 0.0, "{device}: {p:?} is not k/4");
+            let k = p[0] * 4.0;
+            assert!((k - k.round()).abs() < 1e-6, "{device}: {p:?} is not k/4");
         }
         let black = image.pixels.iter().filter(|p| p[0] == 0.0).count();
         let white = image.pixels.iter().filter(|p| p[0] == 1.0).count();

@@ -4,7 +4,7 @@ use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::ImageFormat;
-use crate::render::{mean_image, render_progressive, BatchSizer, Renderer};
+use crate::render::{render_progressive, BatchSizer, Renderer};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -149,15 +149,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
             if report.spp_done < report.spp_target
                 && last_checkpoint.elapsed() >= CHECKPOINT_INTERVAL
             {
-                mean_image(width, height, &r.read_sums()?, report.spp_done).write(&output)?;
+                r.read_mean()?.write(&output)?;
                 last_checkpoint = Instant::now();
             }
             Ok(())
         },
     )?;
     progress.finish_and_clear();
-    let image = mean_image(width, height, &renderer.read_sums()?, stats.spp);
-    image
+    renderer
+        .read_mean()?
         .write(&output)
         .with_context(|| format!("writing {}", output.display()))?;
 

@@ -1,14 +1,16 @@
 //! The CPU renderer: the kernel's entry point run over all pixels, rows in parallel (rayon).
 
-use super::trace::{render_pixel, SceneRefs};
-use crate::render::Renderer;
+use super::trace::{render_pixel, PixelStats, SceneRefs};
+use crate::output::Image;
+use crate::render::{variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use anyhow::Result;
 use rayon::prelude::*;
 
 pub struct CpuRenderer {
     scene: KernelScene,
-    sums: Vec<[f32; 3]>,
+    stats: Vec<PixelStats>,
+    samples: u32,
 }
 
 impl CpuRenderer {
@@ -16,16 +18,25 @@ impl CpuRenderer {
         let pixels = scene.params.width as usize * scene.params.height as usize;
         CpuRenderer {
             scene: scene.clone(),
-            sums: vec![[0.0; 3]; pixels],
+            stats: vec![PixelStats::default(); pixels],
+            samples: 0,
+        }
+    }
+
+    fn image(&self, pixel: impl Fn(&PixelStats) -> [f32; 3] + Sync + Send) -> Image {
+        Image {
+            width: self.scene.params.width,
+            height: self.scene.params.height,
+            pixels: self.stats.par_iter().map(pixel).collect(),
         }
     }
 }
 
 impl Renderer for CpuRenderer {
-    fn add_samples(&mut self, sample_start: u32, sample_count: u32) -> Result<()> {
+    fn add_samples(&mut self, count: u32) -> Result<()> {
         let mut params = self.scene.params;
-        params.sample_start = sample_start;
-        params.sample_count = sample_count;
+        params.sample_start = self.samples;
+        params.sample_count = count;
         let refs = SceneRefs {
             params: &params,
             spheres: &self.scene.spheres,
@@ -33,25 +44,34 @@ impl Renderer for CpuRenderer {
             materials: &self.scene.materials,
         };
         let width = params.width as usize;
-        self.sums
+        self.stats
             .par_chunks_mut(width)
             .enumerate()
             .for_each(|(y, row)| {
-                for (x, sum) in row.iter_mut().enumerate() {
-                    let s = render_pixel(&refs, x as u32, y as u32);
-                    // As the kernel does: one f32 add of the batch's sum per pixel.
-                    *sum = [sum[0] + s.x, sum[1] + s.y, sum[2] + s.z];
+                for (x, stats) in row.iter_mut().enumerate() {
+                    render_pixel(&refs, x as u32, y as u32, stats);
                 }
             });
+        self.samples += count;
         Ok(())
     }
 
-    fn read_sums(&mut self) -> Result<Vec<[f32; 3]>> {
-        Ok(self.sums.clone())
+    fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    fn read_mean(&mut self) -> Result<Image> {
+        Ok(self.image(|s| s.mean.into()))
+    }
+
+    fn read_variance(&mut self) -> Result<Image> {
+        let n = self.samples;
+        Ok(self.image(|s| variance_of_mean(s.m2.into(), n)))
     }
 
     fn reset(&mut self) -> Result<()> {
-        self.sums.fill([0.0; 3]);
+        self.stats.fill(PixelStats::default());
+        self.samples = 0;
         Ok(())
     }
 

@@ -58,14 +58,33 @@ pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) 
     radiance
 }
 
-/// The kernel's entry point for one pixel: the sum of `params.sample_count` samples starting
-/// at `params.sample_start`.
-pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32) -> Vec3 {
+/// Running per-pixel statistics: the mean radiance and M2, the sum of squared deviations.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelStats {
+    pub mean: Vec3,
+    pub m2: Vec3,
+}
+
+/// The kernel's entry point for one pixel: `params.sample_count` samples starting at
+/// `params.sample_start`, merged into `stats`, which holds the `params.sample_start` samples
+/// before them.
+pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) {
     let params = scene.params;
     let pixel = py * params.width + px;
-    let mut sum = Vec3::ZERO;
+    // Welford over this batch's samples...
+    let mut mean = Vec3::ZERO;
+    let mut m2 = Vec3::ZERO;
     for i in 0..params.sample_count {
-        sum += trace_path(scene, pixel, px, py, params.sample_start + i);
+        let x = trace_path(scene, pixel, px, py, params.sample_start + i);
+        let delta = x - mean;
+        mean += delta / (i + 1) as f32;
+        m2 += delta * (x - mean);
     }
-    sum
+    // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
+    let n_old = params.sample_start as f32;
+    let n_new = params.sample_count as f32;
+    let n = n_old + n_new;
+    let delta = mean - stats.mean;
+    stats.mean += delta * (n_new / n);
+    stats.m2 = stats.m2 + m2 + delta * delta * (n_old * n_new / n);
 }

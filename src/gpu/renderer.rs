@@ -1,7 +1,8 @@
 //! The GPU renderer: scene upload, sample batches, readback of the running sums.
 
 use super::context::GpuContext;
-use crate::render::Renderer;
+use crate::output::Image;
+use crate::render::{variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use crate::shader::{render_kernel_source, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
 use crate::shader_types::Params;
@@ -15,8 +16,12 @@ pub struct GpuRenderer<'a> {
     bind_group: wgpu::BindGroup,
     params: Params,
     params_buffer: wgpu::Buffer,
-    accum_buffer: wgpu::Buffer,
+    /// Per pixel vec4: running mean radiance (xyz).
+    mean_buffer: wgpu::Buffer,
+    /// Per pixel vec4: M2, the sum of squared deviations from the mean (xyz).
+    m2_buffer: wgpu::Buffer,
     readback_buffer: wgpu::Buffer,
+    samples: u32,
 }
 
 /// A read-only storage buffer holding `items`; bindings cannot be empty, so an empty list
@@ -72,14 +77,18 @@ impl<'a> GpuRenderer<'a> {
         let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
         let quads = storage_buffer(ctx, "quads", &scene.quads);
         let materials = storage_buffer(ctx, "materials", &scene.materials);
-        let accum_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accum"),
-            size: accum_size,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let accumulator = |label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: accum_size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let mean_buffer = accumulator("accum_mean");
+        let m2_buffer = accumulator("accum_m2");
         let readback_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: accum_size,
@@ -94,7 +103,8 @@ impl<'a> GpuRenderer<'a> {
                 (1, &spheres),
                 (2, &quads),
                 (3, &materials),
-                (4, &accum_buffer),
+                (4, &mean_buffer),
+                (5, &m2_buffer),
             ]
             .map(|(binding, buffer)| wgpu::BindGroupEntry {
                 binding,
@@ -108,16 +118,77 @@ impl<'a> GpuRenderer<'a> {
             bind_group,
             params,
             params_buffer,
-            accum_buffer,
+            mean_buffer,
+            m2_buffer,
             readback_buffer,
+            samples: 0,
         })
+    }
+
+    /// The per-pixel mean radiance (vec4 per pixel, xyz used), for display passes that read it
+    /// on the GPU without a readback.
+    pub fn mean_buffer(&self) -> &wgpu::Buffer {
+        &self.mean_buffer
+    }
+
+    /// The kernel parameters in use (camera, size, counts).
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Replaces the camera and render parameters (not the image size or the scene's objects)
+    /// and restarts accumulation.
+    pub fn set_params(&mut self, params: Params) -> Result<()> {
+        let size = (self.params.width, self.params.height);
+        if (params.width, params.height) != size {
+            return Err(anyhow!(
+                "set_params cannot change the image size; make a new renderer"
+            ));
+        }
+        self.params = params;
+        self.reset()
+    }
+
+    /// The first three floats of each vec4 of `buffer`.
+    fn read_vec3s(&self, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 3]>> {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &self.readback_buffer, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        let slice = self.readback_buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.ctx.wait_idle()?;
+        rx.recv()
+            .map_err(|_| anyhow!("GPU readback was dropped"))?
+            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+        let values = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+            bytemuck::cast_slice::<u8, [f32; 4]>(&view)
+                .iter()
+                .map(|p| [p[0], p[1], p[2]])
+                .collect()
+        };
+        self.readback_buffer.unmap();
+        Ok(values)
+    }
+
+    fn image(&self, pixels: Vec<[f32; 3]>) -> Image {
+        Image {
+            width: self.params.width,
+            height: self.params.height,
+            pixels,
+        }
     }
 }
 
 impl Renderer for GpuRenderer<'_> {
-    fn add_samples(&mut self, sample_start: u32, sample_count: u32) -> Result<()> {
-        self.params.sample_start = sample_start;
-        self.params.sample_count = sample_count;
+    fn add_samples(&mut self, count: u32) -> Result<()> {
+        self.params.sample_start = self.samples;
+        self.params.sample_count = count;
         self.ctx
             .queue
             .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
@@ -136,39 +207,31 @@ impl Renderer for GpuRenderer<'_> {
             );
         }
         self.ctx.queue.submit([encoder.finish()]);
-        self.ctx.wait_idle()
+        self.ctx.wait_idle()?;
+        self.samples += count;
+        Ok(())
     }
 
-    fn read_sums(&mut self) -> Result<Vec<[f32; 3]>> {
-        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.accum_buffer, 0, &self.readback_buffer, 0, None);
-        self.ctx.queue.submit([encoder.finish()]);
-        let slice = self.readback_buffer.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.ctx.wait_idle()?;
-        rx.recv()
-            .map_err(|_| anyhow!("GPU readback was dropped"))?
-            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-        let sums = {
-            let view = slice
-                .get_mapped_range()
-                .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-            bytemuck::cast_slice::<u8, [f32; 4]>(&view)
-                .iter()
-                .map(|p| [p[0], p[1], p[2]])
-                .collect()
-        };
-        self.readback_buffer.unmap();
-        Ok(sums)
+    fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    fn read_mean(&mut self) -> Result<Image> {
+        Ok(self.image(self.read_vec3s(&self.mean_buffer)?))
+    }
+
+    fn read_variance(&mut self) -> Result<Image> {
+        let n = self.samples;
+        let m2 = self.read_vec3s(&self.m2_buffer)?;
+        Ok(self.image(m2.into_iter().map(|v| variance_of_mean(v, n)).collect()))
     }
 
     fn reset(&mut self) -> Result<()> {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        encoder.clear_buffer(&self.accum_buffer, 0, None);
+        encoder.clear_buffer(&self.mean_buffer, 0, None);
+        encoder.clear_buffer(&self.m2_buffer, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
+        self.samples = 0;
         self.ctx.wait_idle()
     }
 

@@ -39,13 +39,11 @@ pub fn kernel_scene(toml: &str) -> KernelScene {
 }
 
 pub fn render_cpu(scene: &KernelScene, spp: u32) -> Image {
-    let mut r = CpuRenderer::new(scene);
-    render_image(&mut r, scene.params.width, scene.params.height, spp, spp).unwrap()
+    render_image(&mut CpuRenderer::new(scene), spp, spp).unwrap()
 }
 
 pub fn render_gpu(ctx: &GpuContext, scene: &KernelScene, spp: u32) -> Image {
-    let mut r = GpuRenderer::new(ctx, scene).unwrap();
-    render_image(&mut r, scene.params.width, scene.params.height, spp, spp).unwrap()
+    render_image(&mut GpuRenderer::new(ctx, scene).unwrap(), spp, spp).unwrap()
 }
 
 /// Renders on the CPU and, where there is a GPU, on the GPU too: (device name, image) pairs.
