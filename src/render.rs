@@ -71,6 +71,7 @@ impl BatchSizer {
 pub enum StopReason {
     SamplesReached,
     TimeLimit,
+    TargetError,
 }
 
 impl StopReason {
@@ -78,12 +79,36 @@ impl StopReason {
         match self {
             StopReason::SamplesReached => "spp",
             StopReason::TimeLimit => "time-limit",
+            StopReason::TargetError => "target-error",
         }
     }
 }
 
+/// Fewest samples per pixel before `--target-error` may stop a render: the image-wide
+/// variance estimate is unbiased from 2 samples on, but a few more keep a lucky start (no
+/// path has found the light yet) from looking converged.
+pub const MIN_SPP_FOR_TARGET_ERROR: u32 = 8;
+
+/// The image's relative standard error: √(mean of the variance image) / (mean of the image),
+/// both over all pixels and channels. `None` when the image is black (no scale to relate to).
+pub fn relative_error(mean: &Image, variance: &Image) -> Option<f64> {
+    let m = mean.mean();
+    (m > 0.0).then(|| variance.mean().max(0.0).sqrt() / m)
+}
+
+/// When to stop besides reaching the sample count.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StopRules {
+    /// Stop at the first batch boundary after this long.
+    pub time_limit: Option<Duration>,
+    /// Stop at the first batch boundary where [`relative_error`] ≤ this.
+    pub target_error: Option<f64>,
+}
+
 /// The state after each batch, for progress reports and checkpoints.
 pub struct BatchReport {
+    /// The image's relative standard error, when a target error asks for it.
+    pub relative_error: Option<f64>,
     pub spp_done: u32,
     pub spp_target: u32,
     /// Time spent in batches only.
@@ -97,20 +122,23 @@ pub struct RenderStats {
     /// Time spent in batches only: no start-up, shader compilation, readback or file writes.
     pub render_time: Duration,
     pub stop_reason: StopReason,
+    /// The relative error at the last check (only measured with a target error).
+    pub relative_error: Option<f64>,
 }
 
-/// Renders up to `spp` samples per pixel, stopping at the first batch boundary after
-/// `time_limit`. `after_batch` sees every batch (progress bars, checkpoints).
+/// Renders up to `spp` samples per pixel, stopping early by `rules`. `after_batch` sees every
+/// batch (progress bars, checkpoints).
 pub fn render_progressive(
     renderer: &mut dyn Renderer,
     spp: u32,
-    time_limit: Option<Duration>,
+    rules: StopRules,
     sizer: &mut BatchSizer,
     mut after_batch: impl FnMut(&mut dyn Renderer, &BatchReport) -> Result<()>,
 ) -> Result<RenderStats> {
     let started = Instant::now();
     let mut render_time = Duration::ZERO;
     let mut stop_reason = StopReason::SamplesReached;
+    let mut error = None;
     while renderer.samples() < spp {
         let count = sizer.spp_per_batch.min(spp - renderer.samples());
         let batch_start = Instant::now();
@@ -119,9 +147,13 @@ pub fn render_progressive(
         render_time += took;
         let spp_done = renderer.samples();
         sizer.update(count, took);
+        if rules.target_error.is_some() && spp_done >= MIN_SPP_FOR_TARGET_ERROR {
+            error = relative_error(&renderer.read_mean()?, &renderer.read_variance()?);
+        }
         after_batch(
             renderer,
             &BatchReport {
+                relative_error: error,
                 spp_done,
                 spp_target: spp,
                 render_time,
@@ -129,7 +161,19 @@ pub fn render_progressive(
                 last_batch_time: took,
             },
         )?;
-        if spp_done < spp && time_limit.is_some_and(|limit| started.elapsed() >= limit) {
+        if spp_done >= spp {
+            break;
+        }
+        if let (Some(target), Some(e)) = (rules.target_error, error) {
+            if e <= target {
+                stop_reason = StopReason::TargetError;
+                break;
+            }
+        }
+        if rules
+            .time_limit
+            .is_some_and(|limit| started.elapsed() >= limit)
+        {
             stop_reason = StopReason::TimeLimit;
             break;
         }
@@ -138,6 +182,7 @@ pub fn render_progressive(
         spp: renderer.samples(),
         render_time,
         stop_reason,
+        relative_error: error,
     })
 }
 

@@ -4,7 +4,7 @@ use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::ImageFormat;
-use crate::render::{render_progressive, BatchSizer, Renderer};
+use crate::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -50,6 +50,14 @@ pub struct RenderArgs {
     /// Stop at the first batch boundary after this many seconds and write what is done.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
+    /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr.
+    #[arg(long, value_name = "FILE.exr")]
+    pub variance: Option<PathBuf>,
+    /// Stop at the first batch boundary where the image's relative standard error,
+    /// √(mean of the variance image) / (mean of the image), is at most E (checked from 8 spp on).
+    /// --spp is then the upper bound, and --time-limit still holds.
+    #[arg(long, value_name = "E", value_parser = parse_target_error)]
+    pub target_error: Option<f64>,
     /// Print a JSON summary on stdout at the end. Its "seconds" is the time spent rendering
     /// batches only: start-up, scene upload, shader compilation and file writes are not in it
     /// ("wall_seconds" is the whole command).
@@ -63,6 +71,14 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
         .map_err(|_| format!("{s:?} is not a number of seconds"))?;
     if !v.is_finite() || v < 0.0 {
         return Err(format!("must be a finite number ≥ 0, got {s}"));
+    }
+    Ok(v)
+}
+
+fn parse_target_error(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if !v.is_finite() || v <= 0.0 {
+        return Err(format!("must be a finite number > 0, got {s}"));
     }
     Ok(v)
 }
@@ -87,6 +103,21 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
     }
 }
 
+/// A writable image path: a known format, in a folder that exists.
+pub(crate) fn check_output_path(output: &Path) -> Result<(), InputError> {
+    ImageFormat::from_path(output).map_err(InputError)?;
+    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(InputError(format!(
+                "{}: the output folder {} does not exist",
+                output.display(),
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 pub fn run(args: RenderArgs) -> Result<()> {
     let started = Instant::now();
     let scene = Scene::load(&args.scene).map_err(InputError::from)?;
@@ -104,13 +135,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.scene));
-    ImageFormat::from_path(&output).map_err(InputError)?;
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
+    check_output_path(&output)?;
+    if let Some(variance) = &args.variance {
+        check_output_path(variance)?;
+        if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
             return Err(InputError(format!(
-                "{}: the output folder {} does not exist",
-                output.display(),
-                dir.display()
+                "{}: --variance needs an .exr file (linear floats)",
+                variance.display()
             ))
             .into());
         }
@@ -137,15 +168,23 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let pixels = width as f64 * height as f64;
     let mut last_checkpoint = Instant::now();
     let mut sizer = BatchSizer::new(BATCH_TARGET);
+    let rules = StopRules {
+        time_limit: args.time_limit.map(Duration::from_secs_f64),
+        target_error: args.target_error,
+    };
     let stats = render_progressive(
         renderer.as_mut(),
         settings.spp,
-        args.time_limit.map(Duration::from_secs_f64),
+        rules,
         &mut sizer,
         |r, report| {
             progress.set_position(report.spp_done as u64);
             let rate = report.last_batch_spp as f64 * pixels / report.last_batch_time.as_secs_f64();
-            progress.set_message(format!("{:.2} M samples/s", rate / 1e6));
+            let mut message = format!("{:.2} M samples/s", rate / 1e6);
+            if let Some(e) = report.relative_error {
+                message += &format!("  rel. error {:.2}%", 100.0 * e);
+            }
+            progress.set_message(message);
             if report.spp_done < report.spp_target
                 && last_checkpoint.elapsed() >= CHECKPOINT_INTERVAL
             {
@@ -156,10 +195,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         },
     )?;
     progress.finish_and_clear();
-    renderer
-        .read_mean()?
-        .write(&output)
+    let mean = renderer.read_mean()?;
+    let variance = renderer.read_variance()?;
+    mean.write(&output)
         .with_context(|| format!("writing {}", output.display()))?;
+    if let Some(path) = &args.variance {
+        variance
+            .write(path)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
 
     if args.json {
         let seconds = stats.render_time.as_secs_f64();
@@ -177,6 +221,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "paths_per_second": paths as f64 / seconds.max(1e-9),
             "wall_seconds": started.elapsed().as_secs_f64(),
             "stopped_by": stats.stop_reason.as_str(),
+            "relative_error": relative_error(&mean, &variance),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
         });
