@@ -5,6 +5,7 @@
 //! (the kernel's structs) → a [`render::Renderer`] (GPU or CPU) → [`output::Image`].
 
 pub mod cli;
+pub mod compare;
 pub mod cpu;
 pub mod error;
 pub mod gpu;

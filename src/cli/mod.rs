@@ -1,5 +1,6 @@
 //! The `glint` command line.
 
+mod compare;
 mod render;
 
 use crate::error::InputError;
@@ -21,6 +22,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene file to a PNG or EXR image.
     Render(render::RenderArgs),
+    /// Compare two EXR renders: error metrics and, with variance images, per-pixel Z-tests.
+    Compare(compare::CompareArgs),
 }
 
 /// Runs the command line; exit code 0 done, 2 bad input (scene or flags), 1 anything else.
@@ -32,6 +35,7 @@ pub fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Compare(args) => compare::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
