@@ -310,3 +310,178 @@ fn without_vulkan_falls_back_to_cpu_unless_gpu_is_required() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no Vulkan device"));
     assert_eq!(files(dir.path()), Vec::<String>::new());
 }
+
+#[test]
+fn variance_and_target_error_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let summary = json(&glint(
+        dir.path(),
+        &[
+            "render",
+            cornell.to_str().unwrap(),
+            "-o",
+            "c.exr",
+            "--variance",
+            "v.exr",
+            "--cpu",
+            "--json",
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "100000",
+            "--target-error",
+            "0.5",
+        ],
+    ));
+    assert_eq!(summary["stopped_by"], "target-error");
+    let error = summary["relative_error"].as_f64().unwrap();
+    assert!(error > 0.0 && error <= 0.5, "{error}");
+    let mean = Image::read_exr(&dir.path().join("c.exr")).unwrap();
+    let variance = Image::read_exr(&dir.path().join("v.exr")).unwrap();
+    assert_eq!((variance.width, variance.height), (24, 24));
+    assert!(variance
+        .pixels
+        .iter()
+        .flatten()
+        .all(|v| *v >= 0.0 && v.is_finite()));
+    // The JSON's relative error is the documented formula over the files written.
+    let recomputed = glint::render::relative_error(&mean, &variance).unwrap();
+    assert!(
+        (recomputed - error).abs() < 1e-9 * error.max(1.0),
+        "{recomputed} vs {error}"
+    );
+
+    let out = glint(
+        dir.path(),
+        &[
+            "render",
+            cornell.to_str().unwrap(),
+            "-o",
+            "c.png",
+            "--variance",
+            "v.png",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains(".exr"));
+    let out = glint(
+        dir.path(),
+        &["render", cornell.to_str().unwrap(), "--target-error", "0"],
+    );
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn compare_reports_metrics_z_tests_and_writes_a_difference_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    for seed in ["1", "2"] {
+        let out = glint(
+            dir.path(),
+            &[
+                "render",
+                cornell.to_str().unwrap(),
+                "-o",
+                &format!("{seed}.exr"),
+                "--variance",
+                &format!("{seed}.var.exr"),
+                "--cpu",
+                "--width",
+                "32",
+                "--height",
+                "32",
+                "--spp",
+                "64",
+                "--seed",
+                seed,
+            ],
+        );
+        assert!(out.status.success());
+    }
+    let out = glint(
+        dir.path(),
+        &[
+            "compare",
+            "1.exr",
+            "2.exr",
+            "--variance-a",
+            "1.var.exr",
+            "--variance-b",
+            "2.var.exr",
+            "--diff",
+            "d.png",
+            "--json",
+        ],
+    );
+    let c = json(&out);
+    assert!(c["rmse"].as_f64().unwrap() > 0.0);
+    assert!(c["relative_mse"].as_f64().unwrap() > 0.0);
+    assert_eq!(c["mean_a"].as_array().unwrap().len(), 3);
+    let z = &c["z_test"];
+    assert_eq!(z["tested"], 32 * 32 * 3);
+    assert!(z["pass_rate"].as_f64().unwrap() > 0.95, "{z}");
+    assert_eq!(
+        image::open(dir.path().join("d.png"))
+            .unwrap()
+            .into_rgb8()
+            .dimensions(),
+        (32, 32)
+    );
+
+    // An image against itself: zero error, every test passes.
+    let out = glint(
+        dir.path(),
+        &[
+            "compare",
+            "1.exr",
+            "1.exr",
+            "--variance-a",
+            "1.var.exr",
+            "--variance-b",
+            "1.var.exr",
+        ],
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(
+        text.contains("RMSE            0.000000") && text.contains("100.00%"),
+        "{text}"
+    );
+
+    // Bad input: a missing file, images of different sizes, a variance without its pair.
+    glint(
+        dir.path(),
+        &[
+            "render",
+            cornell.to_str().unwrap(),
+            "-o",
+            "small.exr",
+            "--cpu",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "1",
+        ],
+    );
+    for (args, needle) in [
+        (vec!["compare", "1.exr", "missing.exr"], "missing.exr"),
+        (vec!["compare", "1.exr", "small.exr"], "sizes differ"),
+        (
+            vec!["compare", "1.exr", "2.exr", "--variance-a", "1.var.exr"],
+            "--variance-b",
+        ),
+    ] {
+        let out = glint(dir.path(), &args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains(needle),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

@@ -1,6 +1,9 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod chi2;
+pub mod probe;
+
 use glint::cpu::renderer::CpuRenderer;
 use glint::gpu::{GpuContext, GpuRenderer};
 use glint::output::Image;
