@@ -1,6 +1,7 @@
 //! The `glint` command line.
 
 mod render;
+mod view;
 
 use crate::error::InputError;
 use clap::{Parser, Subcommand};
@@ -21,6 +22,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene file to a PNG or EXR image.
     Render(render::RenderArgs),
+    /// Open a window that renders the scene progressively; fly around, watch it refine, save.
+    View(view::ViewArgs),
 }
 
 /// Runs the command line; exit code 0 done, 2 bad input (scene or flags), 1 anything else.
@@ -32,6 +35,7 @@ pub fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(args) => render::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
