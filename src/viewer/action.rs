@@ -118,7 +118,7 @@ fn parse_action(command: &str) -> Result<Action, String> {
         },
         "resize" => {
             let v = numbers(2)?;
-            if v.iter().any(|&x| x < 1.0 || x > 16384.0) {
+            if v.iter().any(|x| !(1.0..=16384.0).contains(x)) {
                 return Err("resize takes two sizes in 1..=16384".into());
             }
             Action::Resize {
