@@ -30,7 +30,7 @@ pub enum Action {
     Exposure {
         stops: f32,
     },
-    /// Save what is shown as a PNG next to the working directory.
+    /// Save what is shown as a PNG in the working directory.
     SavePng,
     /// Save the linear mean radiance as an EXR.
     SaveExr,

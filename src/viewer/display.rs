@@ -151,7 +151,7 @@ impl DisplayPass {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    // Every pixel is drawn, so nothing needs loading or clearing first.
+                    // The triangle covers every pixel; clearing rather than loading spares a read.
                     load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
                     store: wgpu::StoreOp::Store,
                 },
