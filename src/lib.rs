@@ -14,3 +14,4 @@ pub mod render;
 pub mod scene;
 pub mod shader;
 pub mod shader_types;
+pub mod viewer;

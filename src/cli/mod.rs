@@ -2,6 +2,7 @@
 
 mod compare;
 mod render;
+mod view;
 
 use crate::error::InputError;
 use clap::{Parser, Subcommand};
@@ -24,6 +25,8 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Compare two EXR renders: error metrics and, with variance images, per-pixel Z-tests.
     Compare(compare::CompareArgs),
+    /// Open a window that renders the scene progressively; fly around, watch it refine, save.
+    View(view::ViewArgs),
 }
 
 /// Runs the command line; exit code 0 done, 2 bad input (scene or flags), 1 anything else.
@@ -36,6 +39,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

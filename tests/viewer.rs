@@ -1,0 +1,455 @@
+//! `glint view` end to end, in a window on an Xvfb display the test starts itself, rendering on
+//! the Vulkan device (lavapipe in CI). The hidden `--log-frames` flag prints one JSON line per
+//! frame and per event; the hidden `--script` flag injects actions before given frames through
+//! the same function mouse and keyboard input go through.
+
+use serde_json::Value;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+const GLINT: &str = env!("CARGO_BIN_EXE_glint");
+
+fn scene_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+fn skip_gpu() -> bool {
+    let skip = std::env::var_os("GLINT_SKIP_GPU_TESTS").is_some();
+    if skip {
+        eprintln!("GLINT_SKIP_GPU_TESTS is set: skipping the viewer");
+    }
+    skip
+}
+
+/// An X server of our own, on a display number it picks (`-displayfd`), killed on drop.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    fn start() -> Xvfb {
+        let mut child = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "640x480x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| {
+                panic!("cannot start Xvfb ({e}): install the xvfb package, as .ci/run does")
+            });
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .unwrap();
+        let number = line.trim();
+        assert!(
+            !number.is_empty() && number.bytes().all(|b| b.is_ascii_digit()),
+            "Xvfb did not report its display number (got {line:?})"
+        );
+        Xvfb {
+            display: format!(":{number}"),
+            child,
+        }
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// `glint view` on `xvfb`, in `dir`.
+fn view_command(xvfb: &Xvfb, dir: &Path, args: &[&str]) -> Command {
+    let mut cmd = Command::new(GLINT);
+    cmd.arg("view")
+        .args(args)
+        .arg("--log-frames")
+        .current_dir(dir)
+        .env("DISPLAY", &xvfb.display)
+        .env_remove("WAYLAND_DISPLAY");
+    cmd
+}
+
+fn lines(stdout: &[u8]) -> Vec<Value> {
+    String::from_utf8_lossy(stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{l:?}: {e}")))
+        .collect()
+}
+
+fn frames(log: &[Value]) -> Vec<&Value> {
+    log.iter()
+        .filter(|l| l.get("frame").is_some() && l.get("event").is_none())
+        .collect()
+}
+
+fn events<'a>(log: &'a [Value], name: &str) -> Vec<&'a Value> {
+    log.iter().filter(|l| l["event"] == name).collect()
+}
+
+fn succeeded(out: &Output) -> Vec<Value> {
+    assert!(
+        out.status.success(),
+        "glint view failed ({}): {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    lines(&out.stdout)
+}
+
+/// Mean sRGB colour of a block of the PNG: columns and rows as fractions of the size.
+fn mean_rgb(png: &image::RgbImage, x: (f32, f32), y: (f32, f32)) -> [f64; 3] {
+    let (w, h) = (png.width() as f32, png.height() as f32);
+    let mut sum = [0.0; 3];
+    let mut n = 0.0;
+    for py in (y.0 * h) as u32..(y.1 * h) as u32 {
+        for px in (x.0 * w) as u32..(x.1 * w) as u32 {
+            let p = png.get_pixel(px, py).0;
+            for c in 0..3 {
+                sum[c] += p[c] as f64;
+            }
+            n += 1.0;
+        }
+    }
+    sum.map(|s| s / n)
+}
+
+/// The side walls of the square Cornell view, at mid-height: between the box's front edge
+/// (2% in from the border) and the back wall (22% in).
+const LEFT_WALL: (f32, f32) = (0.06, 0.16);
+const RIGHT_WALL: (f32, f32) = (0.84, 0.94);
+const WALL_ROWS: (f32, f32) = (0.3, 0.7);
+
+#[test]
+fn cornell_screenshot_shows_the_green_and_red_walls() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let out = view_command(
+        &x,
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--width",
+            "96",
+            "--height",
+            "96",
+            "--frames",
+            "8",
+            "--screenshot",
+            "shot.png",
+        ],
+    )
+    .output()
+    .unwrap();
+    let log = succeeded(&out);
+    let frames = frames(&log);
+    assert_eq!(frames.len(), 8);
+    // The first frame is a 1-spp preview; then samples only accumulate.
+    assert_eq!(frames[0]["spp"], 1);
+    assert_eq!(frames[0]["restarted"], true);
+    for pair in frames.windows(2) {
+        assert_eq!(
+            pair[1]["spp"].as_u64().unwrap(),
+            pair[0]["spp"].as_u64().unwrap() + pair[1]["batch_spp"].as_u64().unwrap()
+        );
+        assert_eq!(pair[1]["restarted"], false);
+    }
+    assert!(frames.iter().all(|f| f["width"] == 96 && f["height"] == 96));
+    let saved = events(&log, "saved");
+    assert_eq!(saved.len(), 1);
+    assert_eq!(saved[0]["spp"], frames[7]["spp"]);
+
+    let png = image::open(dir.path().join("shot.png"))
+        .unwrap()
+        .into_rgb8();
+    assert_eq!(png.dimensions(), (96, 96));
+    let left = mean_rgb(&png, LEFT_WALL, WALL_ROWS);
+    let right = mean_rgb(&png, RIGHT_WALL, WALL_ROWS);
+    assert!(left[1] > 1.5 * left[0], "left wall is green: {left:?}");
+    assert!(right[0] > 1.5 * right[1], "right wall is red: {right:?}");
+}
+
+#[test]
+fn a_camera_move_restarts_the_accumulation_and_exposure_does_not() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let out = view_command(
+        &x,
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--spp-per-frame",
+            "2",
+            "--frames",
+            "12",
+            "--script",
+            "3:orbit 40 0; 5:exposure 1; 6:pan 5 5; 7:dolly 1; 8:fly 0 0 0.1; 9:restart; 10:save-png",
+        ],
+    )
+    .output()
+    .unwrap();
+    let log = succeeded(&out);
+    let spp: Vec<u64> = frames(&log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect();
+    // 1-spp previews at the start and after each move or restart, then 2 per frame.
+    assert_eq!(spp, [1, 3, 5, 1, 3, 5, 1, 1, 1, 1, 3, 5]);
+    let restarted: Vec<bool> = frames(&log)
+        .iter()
+        .map(|f| f["restarted"].as_bool().unwrap())
+        .collect();
+    assert_eq!(
+        restarted,
+        [true, false, false, true, false, false, true, true, true, true, false, false]
+    );
+    let saved = events(&log, "saved");
+    assert_eq!(saved.len(), 1, "P saves once");
+    let name = saved[0]["path"].as_str().unwrap();
+    assert_eq!(name, "cornell-001.png");
+    assert!(dir.path().join(name).is_file());
+}
+
+#[test]
+fn a_resize_restarts_at_the_new_size() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let out = view_command(
+        &x,
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--width",
+            "40",
+            "--height",
+            "40",
+            "--frames",
+            "12",
+            "--script",
+            "2:resize 64 32",
+            "--screenshot",
+            "shot.exr",
+        ],
+    )
+    .output()
+    .unwrap();
+    let log = succeeded(&out);
+    let resized = events(&log, "resize");
+    assert_eq!(resized.len(), 1, "{log:?}");
+    let last = *frames(&log).last().unwrap();
+    assert_eq!(
+        (last["width"].as_u64(), last["height"].as_u64()),
+        (Some(64), Some(32))
+    );
+    let first_big = frames(&log).into_iter().find(|f| f["width"] == 64).unwrap();
+    assert_eq!(first_big["spp"], 1, "the new size starts from a preview");
+    let exr = glint::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
+    assert_eq!((exr.width, exr.height), (64, 32));
+}
+
+/// Reads the viewer's log lines as they come.
+fn spawn_with_log(mut cmd: Command) -> (Child, mpsc::Receiver<Value>) {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines() {
+            let Ok(line) = line else { break };
+            let value = serde_json::from_str(&line).unwrap_or_else(|e| panic!("{line:?}: {e}"));
+            if tx.send(value).is_err() {
+                break;
+            }
+        }
+    });
+    (child, rx)
+}
+
+/// Replaces the file in one step, as editors do, so the viewer never reads half a file.
+fn save_atomically(path: &Path, text: &str) {
+    let tmp = path.with_extension("tmp");
+    std::fs::write(&tmp, text).unwrap();
+    std::fs::rename(&tmp, path).unwrap();
+}
+
+/// Log lines up to and including the first that `pred` accepts.
+fn wait_for(rx: &mpsc::Receiver<Value>, what: &str, pred: impl Fn(&Value) -> bool) -> Vec<Value> {
+    let mut seen = Vec::new();
+    loop {
+        let line = rx
+            .recv_timeout(Duration::from_secs(120))
+            .unwrap_or_else(|_| panic!("no {what} in the viewer's log; got {seen:?}"));
+        let done = pred(&line);
+        seen.push(line);
+        if done {
+            return seen;
+        }
+    }
+}
+
+#[test]
+fn scene_edits_on_disk_are_picked_up_and_broken_ones_keep_the_last_good_scene() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("box.toml");
+    let original = std::fs::read_to_string(scene_path("cornell.toml")).unwrap();
+    std::fs::write(&scene, &original).unwrap();
+    // `wait-edit` holds the viewer at a frame until the file changes, so the edits land at
+    // known frames; the change itself is found by the same polling as any edit.
+    let (child, rx) = spawn_with_log(view_command(
+        &x,
+        dir.path(),
+        &[
+            "box.toml",
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--spp-per-frame",
+            "4",
+            "--frames",
+            "14",
+            "--script",
+            "3:wait-edit; 8:wait-edit",
+            "--screenshot",
+            "shot.png",
+        ],
+    ));
+    let waiting = |v: &Value| v["event"] == "waiting-for-edit";
+    let mut log = wait_for(&rx, "first wait", waiting);
+    // The red wall turns blue.
+    let red = "color = [0.65, 0.05, 0.05]";
+    assert!(original.contains(red));
+    let blue = original.replace(red, "color = [0.05, 0.05, 0.65]");
+    save_atomically(&scene, &blue);
+    log.extend(wait_for(&rx, "second wait", waiting));
+    // A broken edit: a negative radius.
+    let broken = blue.replacen("radius = 90.0", "radius = -2.0", 1);
+    assert_ne!(broken, blue);
+    save_atomically(&scene, &broken);
+    log.extend(rx.iter());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{}: {stderr}", out.status);
+
+    let reloads = events(&log, "reload");
+    assert_eq!(reloads.len(), 2, "{log:?}");
+    assert_eq!(
+        (reloads[0]["ok"].as_bool(), reloads[0]["frame"].as_u64()),
+        (Some(true), Some(3))
+    );
+    assert_eq!(
+        (reloads[1]["ok"].as_bool(), reloads[1]["frame"].as_u64()),
+        (Some(false), Some(8))
+    );
+    let error = reloads[1]["error"].as_str().unwrap();
+    assert!(
+        error.contains("box.toml:") && error.contains("radius"),
+        "{error}"
+    );
+    assert!(stderr.contains("keeping the last good scene"), "{stderr}");
+    assert!(stderr.contains("radius"), "{stderr}");
+
+    let spp: Vec<u64> = frames(&log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect();
+    // The good edit restarts; the broken one changes nothing.
+    assert_eq!(spp, [1, 5, 9, 1, 5, 9, 13, 17, 21, 25, 29, 33, 37, 41]);
+    let png = image::open(dir.path().join("shot.png"))
+        .unwrap()
+        .into_rgb8();
+    let right = mean_rgb(&png, RIGHT_WALL, WALL_ROWS);
+    assert!(
+        right[2] > 1.5 * right[0],
+        "the right wall turned blue: {right:?}"
+    );
+}
+
+#[test]
+fn no_display_is_a_one_line_error_with_exit_code_2() {
+    let cornell = scene_path("cornell.toml");
+    let out = Command::new(GLINT)
+        .args(["view", cornell.to_str().unwrap()])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(lines[0].contains("no display"), "{stderr}");
+    assert!(lines[0].contains("glint render"), "{stderr}");
+}
+
+#[test]
+fn bad_view_input_is_reported_before_any_window() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    for args in [
+        vec!["view", "missing.toml"],
+        vec![
+            "view",
+            cornell.to_str().unwrap(),
+            "--screenshot",
+            "shot.bmp",
+        ],
+        vec![
+            "view",
+            cornell.to_str().unwrap(),
+            "--screenshot",
+            "no/such/dir/shot.png",
+        ],
+        vec!["view", cornell.to_str().unwrap(), "--script", "1:spin"],
+        vec!["view", cornell.to_str().unwrap(), "--frames", "0"],
+    ] {
+        let out = Command::new(GLINT)
+            .args(&args)
+            .current_dir(dir.path())
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(!stderr.contains("no display"), "{args:?}: {stderr}");
+    }
+}
