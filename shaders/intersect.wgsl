@@ -4,11 +4,17 @@ const NO_HIT: f32 = 3.402823e38;
 
 struct Hit {
     t: f32,
+    // The hit point; on spheres projected back onto the surface, so errors cannot build up
+    // over many bounces.
+    position: vec3<f32>,
     // Geometric normal, unit length, facing against the incoming ray.
     normal: vec3<f32>,
     material: u32,
     // True when the ray hit the side the surface's outward normal points to.
     front_face: bool,
+    // Which primitive: PRIMITIVE_SPHERE or PRIMITIVE_QUAD, and its index.
+    primitive: u32,
+    index: u32,
 }
 
 // Nearest t > 0 of a sphere hit, or NO_HIT. The discriminant is r^2 - |oc - h d|^2 rather than
@@ -81,13 +87,19 @@ fn intersect_scene(ray: Ray) -> Hit {
     if best_t == NO_HIT {
         return hit;
     }
+    hit.primitive = select(PRIMITIVE_QUAD, PRIMITIVE_SPHERE, best_is_sphere);
+    hit.index = best_index;
     var outward: vec3<f32>;
     if best_is_sphere {
         let s = spheres[best_index];
-        outward = (ray.origin + best_t * ray.dir - s.center) / s.radius;
+        // Normalised, not divided by the radius: a normal a little too long would make
+        // reflected directions too long, and the error would grow with every bounce.
+        outward = normalize(ray.origin + best_t * ray.dir - s.center);
+        hit.position = s.center + s.radius * outward;
         hit.material = s.material;
     } else {
         outward = quads[best_index].normal;
+        hit.position = ray.origin + best_t * ray.dir;
         hit.material = quads[best_index].material;
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;

@@ -1,7 +1,7 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
 use super::Ray;
-use crate::shader_types::{Quad, Sphere};
+use crate::shader_types::{Quad, Sphere, PRIMITIVE_QUAD, PRIMITIVE_SPHERE};
 use glam::{BVec3, IVec3, Vec3};
 
 pub const NO_HIT: f32 = 3.402823e38;
@@ -9,11 +9,17 @@ pub const NO_HIT: f32 = 3.402823e38;
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub t: f32,
+    /// The hit point; on spheres projected back onto the surface, so errors cannot build up
+    /// over many bounces.
+    pub position: Vec3,
     /// Geometric normal, unit length, facing against the incoming ray.
     pub normal: Vec3,
     pub material: u32,
     /// True when the ray hit the side the surface's outward normal points to.
     pub front_face: bool,
+    /// Which primitive: `PRIMITIVE_SPHERE` or `PRIMITIVE_QUAD`, and its index.
+    pub primitive: u32,
+    pub index: u32,
 }
 
 /// Nearest t > 0 of a sphere hit, or `NO_HIT`. The discriminant is r² − |oc − h d|² rather
@@ -88,27 +94,45 @@ pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
     if best_t == NO_HIT {
         return Hit {
             t: NO_HIT,
+            position: Vec3::ZERO,
             normal: Vec3::ZERO,
             material: 0,
             front_face: false,
+            primitive: 0,
+            index: 0,
         };
     }
-    let (outward, material) = if best_is_sphere {
+    let (outward, position, material) = if best_is_sphere {
         let s = &spheres[best_index];
+        // Normalised, not divided by the radius: a normal a little too long would make
+        // reflected directions too long, and the error would grow with every bounce.
+        let outward = (ray.origin + best_t * ray.dir - Vec3::from(s.center)).normalize();
         (
-            (ray.origin + best_t * ray.dir - Vec3::from(s.center)) / s.radius,
+            outward,
+            Vec3::from(s.center) + s.radius * outward,
             s.material,
         )
     } else {
         let q = &quads[best_index];
-        (Vec3::from(q.normal), q.material)
+        (
+            Vec3::from(q.normal),
+            ray.origin + best_t * ray.dir,
+            q.material,
+        )
     };
     let front_face = outward.dot(ray.dir) < 0.0;
     Hit {
         t: best_t,
+        position,
         normal: if front_face { outward } else { -outward },
         material,
         front_face,
+        primitive: if best_is_sphere {
+            PRIMITIVE_SPHERE
+        } else {
+            PRIMITIVE_QUAD
+        },
+        index: best_index as u32,
     }
 }
 
