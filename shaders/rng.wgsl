@@ -1,6 +1,15 @@
 // Counter-based random numbers (mirror: src/cpu/rng.rs). Every (pixel, sample, stream, seed)
 // gets its own PCG stream, so a sample's numbers do not depend on batch size or on the device.
-// Stream 0 is the camera; stream b + 1 is the scattering at bounce b.
+// Stream 0 is the camera; each bounce has one stream per purpose, so a routine that draws more
+// or fewer numbers never shifts the numbers of another.
+
+const PURPOSE_BSDF: u32 = 0u;
+const PURPOSE_LIGHT: u32 = 1u;
+const PURPOSE_ROULETTE: u32 = 2u;
+
+fn stream_id(bounce: u32, purpose: u32) -> u32 {
+    return 1u + 3u * bounce + purpose;
+}
 
 fn pcg_hash(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;

@@ -4,9 +4,16 @@
 fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
     var camera_rng = rng_init(pixel, sample, 0u, params.seed);
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
-    var ray = camera_ray(px, py, jitter);
+    let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
+    var ray = camera_ray(px, py, jitter, lens);
     var throughput = vec3<f32>(1.0);
     var radiance = vec3<f32>(0.0);
+    // How the current ray was sampled, for weighting the emitter it may hit.
+    var came_from_delta = true;
+    var bsdf_pdf_of_ray = 0.0;
+    // The surface point the current ray left from (light pdfs are evaluated there).
+    var ray_start = ray.origin;
+    let light_sampling = params.light_sampling != 0u && params.emitter_count > 0u;
     // max_bounces counts scattering events; the loop bound also caps a corrupt value.
     for (var bounce = 0u; bounce <= params.max_bounces; bounce++) {
         let hit = intersect_scene(ray);
@@ -15,20 +22,59 @@ fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
             break;
         }
         let m = materials[hit.material];
-        radiance += throughput * m.emission;
+        if any(m.emission > vec3<f32>(0.0)) {
+            // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
+            // from the previous vertex; camera rays and delta bounces count in full.
+            var weight = 1.0;
+            if light_sampling && !came_from_delta {
+                let pdf = light_pdf(ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
+                weight = power_heuristic(bsdf_pdf_of_ray, pdf);
+            }
+            radiance += throughput * m.emission * weight;
+        }
         if bounce == params.max_bounces {
             break;
         }
-        var rng = rng_init(pixel, sample, bounce + 1u, params.seed);
-        let s = scatter(m, ray.dir, hit.normal, &rng);
+        let p = hit.position;
+        let wo = -ray.dir;
+        let origin = offset_ray_origin(p, hit.normal);
+        if light_sampling && !is_delta(m) {
+            // Next-event estimation: light arriving after one more scattering event.
+            var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
+            let light = sample_light(p, origin, &light_rng);
+            if light.pdf > 0.0 {
+                let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
+                if any(f_cos > vec3<f32>(0.0)) {
+                    let blocker = intersect_scene(Ray(origin, light.dir));
+                    if blocker.t != NO_HIT && blocker.primitive == light.primitive && blocker.index == light.index {
+                        let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                        radiance += throughput * f_cos * light.radiance * (weight / light.pdf);
+                    }
+                }
+            }
+        }
+        var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+        let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &bsdf_rng);
         throughput *= s.weight;
         if all(throughput == vec3<f32>(0.0)) {
             break;
         }
-        let p = ray.origin + hit.t * ray.dir;
+        if bounce >= params.roulette_start {
+            // Russian roulette: continue with probability q and divide by it, so the estimate
+            // stays unbiased while dim paths end early.
+            var roulette_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed);
+            let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+            if rng_next(&roulette_rng) >= q {
+                break;
+            }
+            throughput /= q;
+        }
+        came_from_delta = s.is_delta;
+        bsdf_pdf_of_ray = s.pdf;
         // Leave on the side the new direction goes to.
         let side = select(-hit.normal, hit.normal, dot(s.dir, hit.normal) >= 0.0);
         ray = Ray(offset_ray_origin(p, side), s.dir);
+        ray_start = p;
     }
     return radiance;
 }

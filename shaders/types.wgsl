@@ -15,16 +15,30 @@ struct Params {
     sample_count: u32,
     background: vec3<f32>,
     max_bounces: u32,
+    // Thin lens: unit image-right and image-up times the lens radius (zero for a pinhole).
+    lens_right: vec3<f32>,
+    // Distance from the eye to the plane in focus, along `forward`.
+    focus_distance: f32,
+    lens_up: vec3<f32>,
+    // 1: next-event estimation with multiple importance sampling; 0: BSDF sampling only.
+    light_sampling: u32,
     seed: u32,
     sphere_count: u32,
     quad_count: u32,
     material_count: u32,
+    emitter_count: u32,
+    // Russian roulette after the scattering at this bounce and later ones (0xffffffff: off).
+    roulette_start: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 struct Sphere {
     center: vec3<f32>,
     radius: f32,
     material: u32,
+    // Probability that light sampling picks this sphere (0 when it does not emit).
+    light_probability: f32,
 }
 
 struct Quad {
@@ -36,7 +50,8 @@ struct Quad {
     // The plane is dot(normal, p) == plane_offset.
     plane_offset: f32,
     normal: vec3<f32>,
-    pad0: f32,
+    // Probability that light sampling picks this quad (0 when it does not emit).
+    light_probability: f32,
     // edge_u / dot(edge_u, edge_u): dot(u_dual, p - corner) is the position along edge_u in [0, 1].
     u_dual: vec3<f32>,
     pad1: f32,
@@ -46,13 +61,30 @@ struct Quad {
 
 const MATERIAL_DIFFUSE: u32 = 0u;
 const MATERIAL_SPECULAR: u32 = 1u;
+const MATERIAL_METAL: u32 = 2u;
+const MATERIAL_DIELECTRIC: u32 = 3u;
 
 struct Material {
+    // Diffuse albedo, mirror reflectance, metal F0, or glass transmission tint.
     albedo: vec3<f32>,
     kind: u32,
     // emission * strength, already multiplied on the host.
     emission: vec3<f32>,
-    pad0: f32,
+    // GGX alpha (roughness squared) for metal.
+    alpha: f32,
+    ior: f32,
+}
+
+const PRIMITIVE_SPHERE: u32 = 0u;
+const PRIMITIVE_QUAD: u32 = 1u;
+
+// One entry per emitting primitive, for choosing one in proportion to its power.
+struct Emitter {
+    primitive: u32,
+    index: u32,
+    // Sum of the selection probabilities up to and including this emitter (the last is 1).
+    cdf: f32,
+    probability: f32,
 }
 
 struct Ray {
@@ -69,3 +101,4 @@ struct Ray {
 // M2 stay accurate in f32 over millions of samples, where sums of squares would cancel.
 @group(0) @binding(4) var<storage, read_write> accum_mean: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> accum_m2: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> emitters: array<Emitter>;

@@ -3,7 +3,10 @@
 //! Every error names the file, the line and column, and the field, so a user can fix it
 //! without reading code. The format is documented in README.md.
 
-use crate::shader_types::{self, Params, MATERIAL_DIFFUSE, MATERIAL_SPECULAR};
+use crate::shader_types::{
+    self, Emitter, Params, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL,
+    MATERIAL_SPECULAR, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, ROULETTE_OFF,
+};
 use glam::Vec3;
 use serde::de::{self, Deserializer, Visitor};
 use serde::Deserialize;
@@ -23,6 +26,8 @@ pub const MAX_IMAGE_PIXELS: u64 = 1 << 23;
 pub const MAX_BOUNCES_LIMIT: u32 = 1024;
 /// Bound on samples per pixel, so every global sample index fits the kernel's u32 counter.
 pub const MAX_SPP: u32 = 1 << 30;
+/// Russian roulette starts after this many scattering events (when it is on).
+pub const ROULETTE_START_BOUNCE: u32 = 3;
 
 /// A bad scene: where, which field, and what is wrong.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -68,6 +73,10 @@ pub struct Camera {
     pub up: Vec3,
     /// Vertical field of view in degrees, in (0, 180).
     pub vfov: f32,
+    /// Lens diameter; 0 is a pinhole.
+    pub aperture: f32,
+    /// Distance to the plane in focus, along the view direction.
+    pub focus_distance: f32,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -78,12 +87,23 @@ pub struct RenderSettings {
     pub max_bounces: u32,
     pub background: Vec3,
     pub seed: u32,
+    /// Next-event estimation with multiple importance sampling.
+    pub light_sampling: bool,
+    pub russian_roulette: bool,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MaterialKind {
     Diffuse,
     Specular,
+    /// GGX microfacet conductor; roughness in [0, 1], GGX alpha = roughness².
+    Metal {
+        roughness: f32,
+    },
+    /// Smooth glass-like interface with this index of refraction.
+    Dielectric {
+        ior: f32,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -118,6 +138,7 @@ pub struct RenderOverrides {
     pub spp: Option<u32>,
     pub max_bounces: Option<u32>,
     pub seed: Option<u32>,
+    pub light_sampling: Option<bool>,
 }
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
@@ -127,6 +148,7 @@ pub struct KernelScene {
     pub spheres: Vec<shader_types::Sphere>,
     pub quads: Vec<shader_types::Quad>,
     pub materials: Vec<shader_types::Material>,
+    pub emitters: Vec<Emitter>,
 }
 
 impl Scene {
@@ -196,6 +218,7 @@ impl Scene {
         r.spp = o.spp.unwrap_or(r.spp);
         r.max_bounces = o.max_bounces.unwrap_or(r.max_bounces);
         r.seed = o.seed.unwrap_or(r.seed);
+        r.light_sampling = o.light_sampling.unwrap_or(r.light_sampling);
         check_image_size(r.width as i64, r.height as i64)?;
         check_range(r.spp as i64, 1, MAX_SPP as i64).map_err(|m| format!("spp {m}"))?;
         check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)
@@ -213,6 +236,8 @@ impl Scene {
         let v = w.cross(u);
         let half_height = (c.vfov.to_radians() * 0.5).tan();
         let half_width = half_height * r.width as f32 / r.height as f32;
+        let lens_radius = 0.5 * c.aperture;
+        let (emitters, light_probability) = self.emitter_table();
         let params = Params {
             eye: c.eye.into(),
             width: r.width,
@@ -224,25 +249,40 @@ impl Scene {
             sample_count: 0,
             background: r.background.into(),
             max_bounces: r.max_bounces,
+            lens_right: (u * lens_radius).into(),
+            focus_distance: c.focus_distance,
+            lens_up: (v * lens_radius).into(),
+            light_sampling: r.light_sampling as u32,
             seed: r.seed,
             sphere_count: self.spheres.len() as u32,
             quad_count: self.quads.len() as u32,
             material_count: self.materials.len() as u32,
+            emitter_count: emitters.len() as u32,
+            roulette_start: if r.russian_roulette {
+                ROULETTE_START_BOUNCE
+            } else {
+                ROULETTE_OFF
+            },
+            pad0: 0,
+            pad1: 0,
         };
         let spheres = self
             .spheres
             .iter()
-            .map(|s| shader_types::Sphere {
+            .enumerate()
+            .map(|(i, s)| shader_types::Sphere {
                 center: s.center.into(),
                 radius: s.radius,
                 material: s.material,
-                _pad: [0; 3],
+                light_probability: light_probability(PRIMITIVE_SPHERE, i),
+                _pad: [0; 2],
             })
             .collect();
         let quads = self
             .quads
             .iter()
-            .map(|q| {
+            .enumerate()
+            .map(|(i, q)| {
                 let cross = q.u.cross(q.v);
                 let normal = cross.normalize();
                 shader_types::Quad {
@@ -253,6 +293,7 @@ impl Scene {
                     edge_v: q.v.into(),
                     plane_offset: normal.dot(q.corner),
                     normal: normal.into(),
+                    light_probability: light_probability(PRIMITIVE_QUAD, i),
                     u_dual: (q.u / q.u.dot(q.u)).into(),
                     v_dual: (q.v / q.v.dot(q.v)).into(),
                     ..Default::default()
@@ -262,14 +303,23 @@ impl Scene {
         let materials = self
             .materials
             .iter()
-            .map(|m| shader_types::Material {
-                albedo: m.color.into(),
-                kind: match m.kind {
-                    MaterialKind::Diffuse => MATERIAL_DIFFUSE,
-                    MaterialKind::Specular => MATERIAL_SPECULAR,
-                },
-                emission: m.emitted_radiance.into(),
-                pad0: 0.0,
+            .map(|m| {
+                let (kind, alpha, ior) = match m.kind {
+                    MaterialKind::Diffuse => (MATERIAL_DIFFUSE, 0.0, 1.0),
+                    MaterialKind::Specular => (MATERIAL_SPECULAR, 0.0, 1.0),
+                    MaterialKind::Metal { roughness } => {
+                        (MATERIAL_METAL, roughness * roughness, 1.0)
+                    }
+                    MaterialKind::Dielectric { ior } => (MATERIAL_DIELECTRIC, 0.0, ior),
+                };
+                shader_types::Material {
+                    albedo: m.color.into(),
+                    kind,
+                    emission: m.emitted_radiance.into(),
+                    alpha,
+                    ior,
+                    _pad: [0; 3],
+                }
             })
             .collect();
         KernelScene {
@@ -277,7 +327,57 @@ impl Scene {
             spheres,
             quads,
             materials,
+            emitters,
         }
+    }
+
+    /// Every emitting primitive with its selection probability, proportional to its power
+    /// (mean emitted radiance × area; the factor π is common to all), and a lookup of that
+    /// probability by (primitive kind, index).
+    fn emitter_table(&self) -> (Vec<Emitter>, impl Fn(u32, usize) -> f32) {
+        let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
+        let mut powers: Vec<(u32, u32, f64)> = Vec::new();
+        for (i, s) in self.spheres.iter().enumerate() {
+            let power = radiance(s.material).element_sum() as f64 / 3.0
+                * 4.0
+                * std::f64::consts::PI
+                * (s.radius as f64).powi(2);
+            if power > 0.0 {
+                powers.push((PRIMITIVE_SPHERE, i as u32, power));
+            }
+        }
+        for (i, q) in self.quads.iter().enumerate() {
+            let power =
+                radiance(q.material).element_sum() as f64 / 3.0 * q.u.cross(q.v).length() as f64;
+            if power > 0.0 {
+                powers.push((PRIMITIVE_QUAD, i as u32, power));
+            }
+        }
+        let total: f64 = powers.iter().map(|p| p.2).sum();
+        let mut cumulative = 0.0;
+        let mut emitters: Vec<Emitter> = powers
+            .iter()
+            .map(|&(primitive, index, power)| {
+                cumulative += power / total;
+                Emitter {
+                    primitive,
+                    index,
+                    cdf: cumulative as f32,
+                    probability: (power / total) as f32,
+                }
+            })
+            .collect();
+        if let Some(last) = emitters.last_mut() {
+            last.cdf = 1.0;
+        }
+        let lookup = emitters.clone();
+        let probability = move |primitive: u32, index: usize| {
+            lookup
+                .iter()
+                .find(|e| e.primitive == primitive && e.index == index as u32)
+                .map_or(0.0, |e| e.probability)
+        };
+        (emitters, probability)
     }
 }
 
@@ -368,6 +468,8 @@ struct CameraToml {
     target: S<[Real; 3]>,
     up: S<[Real; 3]>,
     vfov: S<Real>,
+    aperture: Option<S<Real>>,
+    focus_distance: Option<S<Real>>,
 }
 
 #[derive(Deserialize)]
@@ -379,6 +481,8 @@ struct RenderToml {
     max_bounces: S<i64>,
     background: Option<S<[Real; 3]>>,
     seed: Option<S<i64>>,
+    light_sampling: Option<bool>,
+    russian_roulette: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -386,9 +490,11 @@ struct RenderToml {
 struct MaterialToml {
     #[serde(rename = "type")]
     kind: S<String>,
-    color: S<[Real; 3]>,
+    color: Option<S<[Real; 3]>>,
     emission: Option<S<[Real; 3]>>,
     strength: Option<S<Real>>,
+    roughness: Option<S<Real>>,
+    ior: Option<S<Real>>,
 }
 
 #[derive(Deserialize)]
@@ -522,6 +628,34 @@ impl SceneToml {
                 ),
             );
         }
+        let aperture = match &camera.aperture {
+            Some(a) => {
+                let v = real(a, "camera.aperture")?;
+                if v < 0.0 {
+                    return fail(
+                        a.span(),
+                        "camera.aperture",
+                        format!("the lens diameter must be ≥ 0, got {v}"),
+                    );
+                }
+                v
+            }
+            None => 0.0,
+        };
+        let focus_distance = match &camera.focus_distance {
+            Some(f) => {
+                let v = real(f, "camera.focus_distance")?;
+                if v <= 0.0 {
+                    return fail(
+                        f.span(),
+                        "camera.focus_distance",
+                        format!("must be > 0, got {v}"),
+                    );
+                }
+                v
+            }
+            None => view.length(),
+        };
 
         let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
         check_image_size(width, height).or_else(|m| {
@@ -555,29 +689,95 @@ impl SceneToml {
         for (name, m) in &self.materials {
             let m = m.get_ref();
             let field = |f: &str| format!("materials.{name}.{f}");
+            let positive =
+                |x: &Option<S<Real>>, name: &str, what: &str| -> Result<f32, FieldError> {
+                    let Some(x) = x else {
+                        return fail(
+                            m.kind.span(),
+                            field(name),
+                            format!("missing: a {what} needs {name}"),
+                        );
+                    };
+                    real(x, &field(name))
+                };
             let kind = match m.kind.get_ref().as_str() {
                 "diffuse" => MaterialKind::Diffuse,
                 "specular" => MaterialKind::Specular,
+                "metal" => {
+                    let roughness = positive(&m.roughness, "roughness", "metal")?;
+                    if !(0.0..=1.0).contains(&roughness) {
+                        return fail(
+                            m.roughness.as_ref().unwrap().span(),
+                            field("roughness"),
+                            format!("must be in [0, 1] (0 = mirror), got {roughness}"),
+                        );
+                    }
+                    MaterialKind::Metal { roughness }
+                }
+                "dielectric" => {
+                    let ior = positive(&m.ior, "ior", "dielectric")?;
+                    if ior <= 0.0 {
+                        return fail(
+                            m.ior.as_ref().unwrap().span(),
+                            field("ior"),
+                            format!("the index of refraction must be > 0, got {ior}"),
+                        );
+                    }
+                    MaterialKind::Dielectric { ior }
+                }
                 other => {
                     return fail(
                         m.kind.span(),
                         field("type"),
                         format!(
-                        "unknown material type {other:?}; known types: \"diffuse\", \"specular\""
-                    ),
+                            "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\""
+                        ),
                     )
                 }
             };
-            let color = non_negative(&m.color, &field("color"))?;
-            if color.max_element() > 1.0 {
-                return fail(
-                    m.color.span(),
-                    field("color"),
-                    format!(
-                        "a reflectance must be in [0, 1] (more would create energy), got {color}"
-                    ),
-                );
+            // A field that does not apply is most likely a mistake: say so.
+            for (value, name, applies) in [
+                (
+                    &m.roughness,
+                    "roughness",
+                    matches!(kind, MaterialKind::Metal { .. }),
+                ),
+                (
+                    &m.ior,
+                    "ior",
+                    matches!(kind, MaterialKind::Dielectric { .. }),
+                ),
+            ] {
+                if let (Some(v), false) = (value, applies) {
+                    return fail(
+                        v.span(),
+                        field(name),
+                        format!("{name} does not apply to a {} material", m.kind.get_ref()),
+                    );
+                }
             }
+            let color = match (&m.color, kind) {
+                (Some(c), _) => {
+                    let color = non_negative(c, &field("color"))?;
+                    if color.max_element() > 1.0 {
+                        return fail(
+                            c.span(),
+                            field("color"),
+                            format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
+                        );
+                    }
+                    color
+                }
+                // Clear glass unless tinted.
+                (None, MaterialKind::Dielectric { .. }) => Vec3::ONE,
+                (None, _) => {
+                    return fail(
+                        m.kind.span(),
+                        field("color"),
+                        "missing: this material needs a color",
+                    );
+                }
+            };
             let emission = match &m.emission {
                 Some(e) => non_negative(e, &field("emission"))?,
                 None => Vec3::ZERO,
@@ -669,6 +869,8 @@ impl SceneToml {
                 target,
                 up,
                 vfov,
+                aperture,
+                focus_distance,
             },
             render: RenderSettings {
                 width: width as u32,
@@ -677,6 +879,8 @@ impl SceneToml {
                 max_bounces,
                 background,
                 seed,
+                light_sampling: render.light_sampling.unwrap_or(true),
+                russian_roulette: render.russian_roulette.unwrap_or(true),
             },
             materials,
             spheres,

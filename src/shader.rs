@@ -1,12 +1,13 @@
 //! The WGSL kernel, assembled from one file per concept in `shaders/` (WGSL has no includes).
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
-pub const SHADER_PARTS: [(&str, &str); 6] = [
+pub const SHADER_PARTS: [(&str, &str); 7] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
+    ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("trace.wgsl", include_str!("../shaders/trace.wgsl")),
 ];
 

@@ -19,11 +19,26 @@ pub struct Params {
     pub sample_count: u32,
     pub background: [f32; 3],
     pub max_bounces: u32,
+    /// Thin lens: unit image-right and image-up times the lens radius (zero for a pinhole).
+    pub lens_right: [f32; 3],
+    /// Distance from the eye to the plane in focus, along `forward`.
+    pub focus_distance: f32,
+    pub lens_up: [f32; 3],
+    /// 1: next-event estimation with multiple importance sampling; 0: BSDF sampling only.
+    pub light_sampling: u32,
     pub seed: u32,
     pub sphere_count: u32,
     pub quad_count: u32,
     pub material_count: u32,
+    pub emitter_count: u32,
+    /// Russian roulette after the scattering at this bounce and later ones (`ROULETTE_OFF`: off).
+    pub roulette_start: u32,
+    pub pad0: u32,
+    pub pad1: u32,
 }
+
+/// `Params::roulette_start` that turns Russian roulette off.
+pub const ROULETTE_OFF: u32 = u32::MAX;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -31,7 +46,9 @@ pub struct Sphere {
     pub center: [f32; 3],
     pub radius: f32,
     pub material: u32,
-    pub _pad: [u32; 3],
+    /// Probability that light sampling picks this sphere (0 when it does not emit).
+    pub light_probability: f32,
+    pub _pad: [u32; 2],
 }
 
 #[repr(C)]
@@ -45,7 +62,8 @@ pub struct Quad {
     /// The plane is `dot(normal, p) == plane_offset`.
     pub plane_offset: f32,
     pub normal: [f32; 3],
-    pub pad0: f32,
+    /// Probability that light sampling picks this quad (0 when it does not emit).
+    pub light_probability: f32,
     /// `edge_u / dot(edge_u, edge_u)`.
     pub u_dual: [f32; 3],
     pub pad1: f32,
@@ -56,13 +74,33 @@ pub struct Quad {
 
 pub const MATERIAL_DIFFUSE: u32 = 0;
 pub const MATERIAL_SPECULAR: u32 = 1;
+pub const MATERIAL_METAL: u32 = 2;
+pub const MATERIAL_DIELECTRIC: u32 = 3;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Material {
+    /// Diffuse albedo, mirror reflectance, metal F0, or glass transmission tint.
     pub albedo: [f32; 3],
     pub kind: u32,
     /// `emission * strength`.
     pub emission: [f32; 3],
-    pub pad0: f32,
+    /// GGX alpha (roughness squared) for metal.
+    pub alpha: f32,
+    pub ior: f32,
+    pub _pad: [u32; 3],
+}
+
+pub const PRIMITIVE_SPHERE: u32 = 0;
+pub const PRIMITIVE_QUAD: u32 = 1;
+
+/// One entry per emitting primitive, for choosing one in proportion to its power.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Emitter {
+    pub primitive: u32,
+    pub index: u32,
+    /// Sum of the selection probabilities up to and including this emitter (the last is 1).
+    pub cdf: f32,
+    pub probability: f32,
 }

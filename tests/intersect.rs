@@ -30,6 +30,8 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             target: Vec3::Z,
             up: Vec3::Y,
             vfov: 40.0,
+            aperture: 0.0,
+            focus_distance: 1.0,
         },
         render: glint::scene::RenderSettings {
             width: 1,
@@ -38,6 +40,8 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             max_bounces: 1,
             background: Vec3::ZERO,
             seed: 0,
+            light_sampling: true,
+            russian_roulette: true,
         },
         materials: vec![Material {
             name: "m".into(),

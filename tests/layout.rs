@@ -2,7 +2,7 @@
 //! byte for byte (naga's layouter), so the host and the kernel cannot drift apart.
 
 use glint::shader::{render_kernel_source, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
-use glint::shader_types::{Material, Params, Quad, Sphere};
+use glint::shader_types::{Emitter, Material, Params, Quad, Sphere};
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
 
@@ -83,13 +83,26 @@ fn rust_structs_match_wgsl_layout() {
             sample_count,
             background,
             max_bounces,
+            lens_right,
+            focus_distance,
+            lens_up,
+            light_sampling,
             seed,
             sphere_count,
             quad_count,
-            material_count
+            material_count,
+            emitter_count,
+            roulette_start,
+            pad0,
+            pad1
         ]
     );
-    assert_same_layout!(&module, Sphere, "Sphere", [center, radius, material]);
+    assert_same_layout!(
+        &module,
+        Sphere,
+        "Sphere",
+        [center, radius, material, light_probability]
+    );
     assert_same_layout!(
         &module,
         Quad,
@@ -102,7 +115,7 @@ fn rust_structs_match_wgsl_layout() {
             edge_v,
             plane_offset,
             normal,
-            pad0,
+            light_probability,
             u_dual,
             pad1,
             v_dual,
@@ -113,7 +126,13 @@ fn rust_structs_match_wgsl_layout() {
         &module,
         Material,
         "Material",
-        [albedo, kind, emission, pad0]
+        [albedo, kind, emission, alpha, ior]
+    );
+    assert_same_layout!(
+        &module,
+        Emitter,
+        "Emitter",
+        [primitive, index, cdf, probability]
     );
 }
 

@@ -41,6 +41,9 @@ pub struct RenderArgs {
     /// Random seed (overrides [render] seed).
     #[arg(long, allow_negative_numbers = true)]
     pub seed: Option<u32>,
+    /// Next-event estimation with multiple importance sampling (overrides [render] light_sampling).
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub light_sampling: Option<bool>,
     /// Render on the CPU reference.
     #[arg(long, conflicts_with = "gpu")]
     pub cpu: bool,
@@ -73,6 +76,14 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
         return Err(format!("must be a finite number ≥ 0, got {s}"));
     }
     Ok(v)
+}
+
+fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got {s:?}")),
+    }
 }
 
 fn parse_target_error(s: &str) -> Result<f64, String> {
@@ -127,6 +138,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         spp: args.spp,
         max_bounces: args.max_bounces,
         seed: args.seed,
+        light_sampling: args.light_sampling,
     };
     let scene = scene
         .with_overrides(&overrides)

@@ -4,6 +4,7 @@
 
 pub mod camera;
 pub mod intersect;
+pub mod lights;
 pub mod material;
 pub mod renderer;
 pub mod rng;

@@ -42,6 +42,7 @@ impl Renderer for CpuRenderer {
             spheres: &self.scene.spheres,
             quads: &self.scene.quads,
             materials: &self.scene.materials,
+            emitters: &self.scene.emitters,
         };
         let width = params.width as usize;
         self.stats

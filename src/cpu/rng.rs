@@ -1,5 +1,14 @@
 //! Counter-based random numbers (WGSL side: `shaders/rng.wgsl`), bit for bit.
-//! Stream 0 is the camera; stream `b + 1` is the scattering at bounce `b`.
+//! Stream 0 is the camera; each bounce has one stream per purpose, so a routine that draws
+//! more or fewer numbers never shifts the numbers of another.
+
+pub const PURPOSE_BSDF: u32 = 0;
+pub const PURPOSE_LIGHT: u32 = 1;
+pub const PURPOSE_ROULETTE: u32 = 2;
+
+pub fn stream_id(bounce: u32, purpose: u32) -> u32 {
+    1 + 3 * bounce + purpose
+}
 
 pub fn pcg_hash(v: u32) -> u32 {
     let state = v.wrapping_mul(747796405).wrapping_add(2891336453);

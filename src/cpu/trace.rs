@@ -2,10 +2,11 @@
 
 use super::camera::camera_ray;
 use super::intersect::{intersect_scene, offset_ray_origin, NO_HIT};
-use super::material::scatter;
-use super::rng::Rng;
+use super::lights::{light_pdf, power_heuristic, sample_light};
+use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
+use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::Ray;
-use crate::shader_types::{Material, Params, Quad, Sphere};
+use crate::shader_types::{Emitter, Material, Params, Quad, Sphere};
 use glam::Vec3;
 
 /// The scene as the kernel sees it.
@@ -14,6 +15,7 @@ pub struct SceneRefs<'a> {
     pub spheres: &'a [Sphere],
     pub quads: &'a [Quad],
     pub materials: &'a [Material],
+    pub emitters: &'a [Emitter],
 }
 
 /// Radiance carried by one camera path through pixel (px, py).
@@ -21,9 +23,16 @@ pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) 
     let params = scene.params;
     let mut camera_rng = Rng::new(pixel, sample, 0, params.seed);
     let jitter = (camera_rng.next_f32(), camera_rng.next_f32());
-    let mut ray = camera_ray(params, px, py, jitter);
+    let lens = (camera_rng.next_f32(), camera_rng.next_f32());
+    let mut ray = camera_ray(params, px, py, jitter, lens);
     let mut throughput = Vec3::ONE;
     let mut radiance = Vec3::ZERO;
+    // How the current ray was sampled, for weighting the emitter it may hit.
+    let mut came_from_delta = true;
+    let mut bsdf_pdf_of_ray = 0.0;
+    // The surface point the current ray left from (light pdfs are evaluated there).
+    let mut ray_start = ray.origin;
+    let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
     let background = Vec3::from(params.background);
     // max_bounces counts scattering events.
     for bounce in 0..=params.max_bounces {
@@ -33,17 +42,80 @@ pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) 
             break;
         }
         let m = &scene.materials[hit.material as usize];
-        radiance += throughput * Vec3::from(m.emission);
+        let emission = Vec3::from(m.emission);
+        if emission.cmpgt(Vec3::ZERO).any() {
+            // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
+            // from the previous vertex; camera rays and delta bounces count in full.
+            let mut weight = 1.0;
+            if light_sampling && !came_from_delta {
+                let pdf = light_pdf(
+                    scene,
+                    ray_start,
+                    ray.origin,
+                    ray.dir,
+                    hit.primitive,
+                    hit.index,
+                );
+                weight = power_heuristic(bsdf_pdf_of_ray, pdf);
+            }
+            radiance += throughput * emission * weight;
+        }
         if bounce == params.max_bounces {
             break;
         }
-        let mut rng = Rng::new(pixel, sample, bounce + 1, params.seed);
-        let s = scatter(m, ray.dir, hit.normal, &mut rng);
+        let p = hit.position;
+        let wo = -ray.dir;
+        let origin = offset_ray_origin(p, hit.normal);
+        if light_sampling && !is_delta(m) {
+            // Next-event estimation: light arriving after one more scattering event.
+            let mut light_rng =
+                Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
+            let light = sample_light(scene, p, origin, &mut light_rng);
+            if light.pdf > 0.0 {
+                let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
+                if f_cos.cmpgt(Vec3::ZERO).any() {
+                    let blocker = intersect_scene(
+                        scene.spheres,
+                        scene.quads,
+                        &Ray {
+                            origin,
+                            dir: light.dir,
+                        },
+                    );
+                    if blocker.t != NO_HIT
+                        && blocker.primitive == light.primitive
+                        && blocker.index == light.index
+                    {
+                        let weight =
+                            power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                        radiance += throughput * f_cos * light.radiance * (weight / light.pdf);
+                    }
+                }
+            }
+        }
+        let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+        let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &mut bsdf_rng);
         throughput *= s.weight;
         if throughput == Vec3::ZERO {
             break;
         }
-        let p = ray.origin + hit.t * ray.dir;
+        if bounce >= params.roulette_start {
+            // Russian roulette: continue with probability q and divide by it, so the estimate
+            // stays unbiased while dim paths end early.
+            let mut roulette_rng = Rng::new(
+                pixel,
+                sample,
+                stream_id(bounce, PURPOSE_ROULETTE),
+                params.seed,
+            );
+            let q = throughput.x.max(throughput.y.max(throughput.z)).min(0.95);
+            if roulette_rng.next_f32() >= q {
+                break;
+            }
+            throughput /= q;
+        }
+        came_from_delta = s.is_delta;
+        bsdf_pdf_of_ray = s.pdf;
         // Leave on the side the new direction goes to.
         let side = if s.dir.dot(hit.normal) >= 0.0 {
             hit.normal
@@ -54,6 +126,7 @@ pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) 
             origin: offset_ray_origin(p, side),
             dir: s.dir,
         };
+        ray_start = p;
     }
     radiance
 }

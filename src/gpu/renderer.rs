@@ -77,6 +77,7 @@ impl<'a> GpuRenderer<'a> {
         let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
         let quads = storage_buffer(ctx, "quads", &scene.quads);
         let materials = storage_buffer(ctx, "materials", &scene.materials);
+        let emitters = storage_buffer(ctx, "emitters", &scene.emitters);
         let accumulator = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -105,6 +106,7 @@ impl<'a> GpuRenderer<'a> {
                 (3, &materials),
                 (4, &mean_buffer),
                 (5, &m2_buffer),
+                (6, &emitters),
             ]
             .map(|(binding, buffer)| wgpu::BindGroupEntry {
                 binding,

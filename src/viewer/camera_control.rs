@@ -105,6 +105,8 @@ mod tests {
             target: Vec3::new(278.0, 278.0, 0.0),
             up: Vec3::Y,
             vfov: 40.0,
+            aperture: 0.0,
+            focus_distance: 800.0,
         }
     }
 

@@ -1,0 +1,148 @@
+// Light sampling for next-event estimation (mirror: src/cpu/lights.rs). An emitter is chosen
+// in proportion to its power, then a direction towards it: quads by area, spheres by the cone
+// of directions they subtend from outside, and by area from inside (where there is no cone).
+// All pdfs are per unit solid angle at the shading point and include the selection probability.
+
+struct LightSample {
+    dir: vec3<f32>,
+    // Solid-angle pdf of `dir`; 0 when no light could be sampled.
+    pdf: f32,
+    radiance: vec3<f32>,
+    primitive: u32,
+    index: u32,
+}
+
+// Selection by the emitters' cumulative probabilities.
+fn pick_emitter(u: f32) -> u32 {
+    for (var i = 0u; i + 1u < params.emitter_count; i++) {
+        if u < emitters[i].cdf {
+            return i;
+        }
+    }
+    return params.emitter_count - 1u;
+}
+
+fn sphere_contains(s: Sphere, p: vec3<f32>) -> bool {
+    let d = p - s.center;
+    return dot(d, d) < s.radius * s.radius;
+}
+
+// 1 - cos(theta_max) of the cone a sphere subtends from outside, without cancellation for
+// small, distant spheres: sin^2 / (1 + cos).
+fn cone_one_minus_cos(s: Sphere, p: vec3<f32>) -> f32 {
+    let d = s.center - p;
+    let sin2 = min(s.radius * s.radius / dot(d, d), 1.0);
+    return sin2 / (1.0 + sqrt(1.0 - sin2));
+}
+
+// Leaving a point p inside (or on) a sphere along a unit direction: the distance t to the
+// sphere and the cosine there, from the chord's geometry. With h = dir . (center - p), the
+// exit is at t = h + sqrt(h^2 + r^2 - |center - p|^2) and the cosine is that square root / r.
+// Keeping r^2 - |center - p|^2 apart (clamped at 0, for p on the surface) stays accurate for
+// nearly tangent directions, where h is tiny.
+struct Chord {
+    t: f32,
+    cos_exit: f32,
+}
+
+fn sphere_chord(s: Sphere, p: vec3<f32>, dir: vec3<f32>) -> Chord {
+    let oc = s.center - p;
+    let h = dot(dir, oc);
+    let root = sqrt(h * h + max(0.0, s.radius * s.radius - dot(oc, oc)));
+    return Chord(h + root, root / s.radius);
+}
+
+// Solid-angle pdf of area sampling: distance^2 / (|cos| at the light * area).
+fn area_to_solid_angle(t: f32, cos_light: f32, area: f32) -> f32 {
+    return t * t / (max(abs(cos_light), 1e-12) * area);
+}
+
+// Every pdf here is evaluated at the shading point `p` itself, the same way for a light sample
+// and for a BSDF-sampled ray, so the two strategies' MIS weights match. `probe` is `p` moved
+// off the surface to the side light arrives from: it decides whether p is inside a sphere
+// (a point on the sphere itself is ambiguous) and starts the shadow ray.
+fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> LightSample {
+    var out: LightSample;
+    out.pdf = 0.0;
+    if params.emitter_count == 0u {
+        return out;
+    }
+    let e = emitters[pick_emitter(rng_next(rng))];
+    let u = vec2<f32>(rng_next(rng), rng_next(rng));
+    out.primitive = e.primitive;
+    out.index = e.index;
+    if e.primitive == PRIMITIVE_QUAD {
+        let q = quads[e.index];
+        let to_light = q.corner + u.x * q.edge_u + u.y * q.edge_v - p;
+        let t = length(to_light);
+        if t <= 0.0 {
+            return out;
+        }
+        out.dir = to_light / t;
+        out.pdf = e.probability * area_to_solid_angle(t, dot(q.normal, out.dir), q.area);
+        out.radiance = materials[q.material].emission;
+        return out;
+    }
+    let s = spheres[e.index];
+    out.radiance = materials[s.material].emission;
+    if sphere_contains(s, probe) {
+        // Uniform on the sphere's area; from inside, every direction meets it exactly once.
+        let z = 1.0 - 2.0 * u.x;
+        let r = sqrt(max(0.0, 1.0 - z * z));
+        let phi = 2.0 * PI * u.y;
+        let normal = vec3<f32>(r * cos(phi), r * sin(phi), z);
+        let to_light = s.center + s.radius * normal - p;
+        let distance = length(to_light);
+        if distance <= 0.0 {
+            return out;
+        }
+        out.dir = to_light / distance;
+        // The same formula as light_pdf, so both strategies agree on this direction's pdf.
+        let chord = sphere_chord(s, p, out.dir);
+        out.pdf = e.probability * area_to_solid_angle(chord.t, chord.cos_exit, 4.0 * PI * s.radius * s.radius);
+        return out;
+    }
+    // Uniform in the cone of directions towards the sphere.
+    let axis = normalize(s.center - p);
+    let one_minus_cos_max = cone_one_minus_cos(s, p);
+    let one_minus_cos = u.x * one_minus_cos_max;
+    let cos_theta = 1.0 - one_minus_cos;
+    let sin_theta = sqrt(max(0.0, one_minus_cos * (2.0 - one_minus_cos)));
+    let phi = 2.0 * PI * u.y;
+    out.dir = normalize(sin_theta * cos(phi) * basis_tangent(axis) + sin_theta * sin(phi) * basis_bitangent(axis) + cos_theta * axis);
+    out.pdf = e.probability / (2.0 * PI * one_minus_cos_max);
+    return out;
+}
+
+// The pdf with which sample_light(p, probe) would have produced `dir`, a direction that meets
+// the emitting primitive (primitive, index).
+fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, index: u32) -> f32 {
+    if primitive == PRIMITIVE_QUAD {
+        let q = quads[index];
+        let cos_light = dot(q.normal, dir);
+        let t = (q.plane_offset - dot(q.normal, p)) / cos_light;
+        if !(t > 0.0) {
+            return 0.0;
+        }
+        return q.light_probability * area_to_solid_angle(t, cos_light, q.area);
+    }
+    let s = spheres[index];
+    if sphere_contains(s, probe) {
+        let chord = sphere_chord(s, p, dir);
+        if !(chord.t > 0.0) {
+            return 0.0;
+        }
+        return s.light_probability * area_to_solid_angle(chord.t, chord.cos_exit, 4.0 * PI * s.radius * s.radius);
+    }
+    return s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p));
+}
+
+// Veach's power heuristic (beta = 2) for the sample drawn with pdf `a` against pdf `b`.
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    let b2 = b * b;
+    if a2 + b2 == 0.0 {
+        return 0.0;
+    }
+    return a2 / (a2 + b2);
+}

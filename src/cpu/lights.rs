@@ -1,0 +1,167 @@
+//! Light sampling for next-event estimation (WGSL side: `shaders/lights.wgsl`). An emitter is
+//! chosen in proportion to its power, then a direction towards it: quads by area, spheres by
+//! the cone of directions they subtend from outside, and by area from inside. All pdfs are per
+//! unit solid angle at the shading point and include the selection probability.
+
+use super::material::{basis, PI};
+use super::rng::Rng;
+use super::trace::SceneRefs;
+use crate::shader_types::{Sphere, PRIMITIVE_QUAD};
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    pub dir: Vec3,
+    /// Solid-angle pdf of `dir`; 0 when no light could be sampled.
+    pub pdf: f32,
+    pub radiance: Vec3,
+    pub primitive: u32,
+    pub index: u32,
+}
+
+/// Selection by the emitters' cumulative probabilities.
+pub fn pick_emitter(scene: &SceneRefs, u: f32) -> usize {
+    let count = scene.params.emitter_count as usize;
+    (0..count.saturating_sub(1))
+        .find(|&i| u < scene.emitters[i].cdf)
+        .unwrap_or(count - 1)
+}
+
+pub fn sphere_contains(s: &Sphere, p: Vec3) -> bool {
+    let d = p - Vec3::from(s.center);
+    d.dot(d) < s.radius * s.radius
+}
+
+/// 1 − cos θmax of the cone a sphere subtends from outside, without cancellation for small,
+/// distant spheres: sin² / (1 + cos).
+pub fn cone_one_minus_cos(s: &Sphere, p: Vec3) -> f32 {
+    let d = Vec3::from(s.center) - p;
+    let sin2 = (s.radius * s.radius / d.dot(d)).min(1.0);
+    sin2 / (1.0 + (1.0 - sin2).sqrt())
+}
+
+/// Leaving a point p inside (or on) a sphere along a unit direction: the distance t to the
+/// sphere and the cosine there, from the chord's geometry. With h = dir · (center − p), the
+/// exit is at t = h + √(h² + r² − |center − p|²) and the cosine is that square root / r.
+/// Keeping r² − |center − p|² apart (clamped at 0, for p on the surface) stays accurate for
+/// nearly tangent directions, where h is tiny.
+pub fn sphere_chord(s: &Sphere, p: Vec3, dir: Vec3) -> (f32, f32) {
+    let oc = Vec3::from(s.center) - p;
+    let h = dir.dot(oc);
+    let root = (h * h + (s.radius * s.radius - oc.dot(oc)).max(0.0)).sqrt();
+    (h + root, root / s.radius)
+}
+
+/// Solid-angle pdf of area sampling: distance² / (|cos| at the light · area).
+pub fn area_to_solid_angle(t: f32, cos_light: f32, area: f32) -> f32 {
+    t * t / (cos_light.abs().max(1e-12) * area)
+}
+
+/// Every pdf here is evaluated at the shading point `p` itself, the same way for a light
+/// sample and for a BSDF-sampled ray, so the two strategies' MIS weights match. `probe` is `p`
+/// moved off the surface to the side light arrives from: it decides whether p is inside a
+/// sphere (a point on the sphere itself is ambiguous) and starts the shadow ray.
+pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> LightSample {
+    let mut out = LightSample {
+        dir: Vec3::ZERO,
+        pdf: 0.0,
+        radiance: Vec3::ZERO,
+        primitive: 0,
+        index: 0,
+    };
+    if scene.params.emitter_count == 0 {
+        return out;
+    }
+    let e = scene.emitters[pick_emitter(scene, rng.next_f32())];
+    let u = (rng.next_f32(), rng.next_f32());
+    out.primitive = e.primitive;
+    out.index = e.index;
+    if e.primitive == PRIMITIVE_QUAD {
+        let q = &scene.quads[e.index as usize];
+        let to_light =
+            Vec3::from(q.corner) + u.0 * Vec3::from(q.edge_u) + u.1 * Vec3::from(q.edge_v) - p;
+        let t = to_light.length();
+        if t <= 0.0 {
+            return out;
+        }
+        out.dir = to_light / t;
+        out.pdf = e.probability * area_to_solid_angle(t, Vec3::from(q.normal).dot(out.dir), q.area);
+        out.radiance = Vec3::from(scene.materials[q.material as usize].emission);
+        return out;
+    }
+    let s = &scene.spheres[e.index as usize];
+    out.radiance = Vec3::from(scene.materials[s.material as usize].emission);
+    if sphere_contains(s, probe) {
+        // Uniform on the sphere's area; from inside, every direction meets it exactly once.
+        let z = 1.0 - 2.0 * u.0;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.1;
+        let normal = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+        let to_light = Vec3::from(s.center) + s.radius * normal - p;
+        let distance = to_light.length();
+        if distance <= 0.0 {
+            return out;
+        }
+        out.dir = to_light / distance;
+        // The same formula as light_pdf, so both strategies agree on this direction's pdf.
+        let (t, cos_exit) = sphere_chord(s, p, out.dir);
+        out.pdf = e.probability * area_to_solid_angle(t, cos_exit, 4.0 * PI * s.radius * s.radius);
+        return out;
+    }
+    // Uniform in the cone of directions towards the sphere.
+    let axis = (Vec3::from(s.center) - p).normalize();
+    let one_minus_cos_max = cone_one_minus_cos(s, p);
+    let one_minus_cos = u.0 * one_minus_cos_max;
+    let cos_theta = 1.0 - one_minus_cos;
+    let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.1;
+    let (t, b) = basis(axis);
+    out.dir =
+        (sin_theta * phi.cos() * t + sin_theta * phi.sin() * b + cos_theta * axis).normalize();
+    out.pdf = e.probability / (2.0 * PI * one_minus_cos_max);
+    out
+}
+
+/// The pdf with which [`sample_light`]`(p, probe)` would have produced `dir`, a direction that
+/// meets the emitting primitive (primitive, index).
+pub fn light_pdf(
+    scene: &SceneRefs,
+    p: Vec3,
+    probe: Vec3,
+    dir: Vec3,
+    primitive: u32,
+    index: u32,
+) -> f32 {
+    if primitive == PRIMITIVE_QUAD {
+        let q = &scene.quads[index as usize];
+        let normal = Vec3::from(q.normal);
+        let cos_light = normal.dot(dir);
+        let t = (q.plane_offset - normal.dot(p)) / cos_light;
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(t > 0.0) {
+            return 0.0;
+        }
+        return q.light_probability * area_to_solid_angle(t, cos_light, q.area);
+    }
+    let s = &scene.spheres[index as usize];
+    if sphere_contains(s, probe) {
+        let (t, cos_exit) = sphere_chord(s, p, dir);
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(t > 0.0) {
+            return 0.0;
+        }
+        return s.light_probability
+            * area_to_solid_angle(t, cos_exit, 4.0 * PI * s.radius * s.radius);
+    }
+    s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p))
+}
+
+/// Veach's power heuristic (β = 2) for the sample drawn with pdf `a` against pdf `b`.
+pub fn power_heuristic(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    let b2 = b * b;
+    if a2 + b2 == 0.0 {
+        return 0.0;
+    }
+    a2 / (a2 + b2)
+}
