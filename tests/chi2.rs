@@ -3,8 +3,8 @@
 //! Šidák-corrected over the suite's CHI2_TESTS_IN_SUITE tests (tests/common/chi2.rs).
 
 mod common;
-use common::chi2::{assert_fits, directions, uniform_2d};
-use common::probe::run_probe;
+use common::chi2::{assert_fits, directions, directions_integrated, pearson, uniform_2d};
+use common::probe::{run_probe, ProbeParams};
 use glam::Vec3;
 use glint::cpu::material::sample_cosine_hemisphere;
 use glint::cpu::rng::Rng;
@@ -22,6 +22,33 @@ fn normals() -> [(&'static str, Vec3); 4] {
         ("+x", Vec3::X),
     ]
 }
+
+fn probe(normal: Vec3, count: u32, seed: u32) -> ProbeParams {
+    ProbeParams {
+        normal: normal.into(),
+        count,
+        seed,
+        ..Default::default()
+    }
+}
+
+/// A scene for probes that read none of it.
+fn empty_scene() -> glint::scene::KernelScene {
+    common::kernel_scene(SCENE_HEADER)
+}
+
+const SCENE_HEADER: &str = r#"
+[camera]
+eye = [0.0, 0.0, -5.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+[render]
+width = 1
+height = 1
+spp = 1
+max_bounces = 1
+"#;
 
 fn cosine_pdf(n: Vec3) -> impl Fn(Vec3) -> f64 {
     move |d: Vec3| (d.dot(n) as f64).max(0.0) / PI
@@ -46,7 +73,12 @@ fn cpu_uniform_stream() {
 #[test]
 fn gpu_uniform_stream() {
     let Some(ctx) = common::gpu() else { return };
-    let out = run_probe(ctx, "probe_uniform", Vec3::Z, SAMPLES / 2, SEED);
+    let out = run_probe(
+        ctx,
+        "probe_uniform",
+        probe(Vec3::Z, SAMPLES / 2, SEED),
+        &empty_scene(),
+    );
     let samples: Vec<[f32; 2]> = out
         .iter()
         .flat_map(|v| [[v[0], v[1]], [v[2], v[3]]])
@@ -76,10 +108,15 @@ fn gpu_cosine_hemisphere() {
     let Some(ctx) = common::gpu() else { return };
     for (k, (name, n)) in normals().into_iter().enumerate() {
         let seed = SEED + 11 + k as u32;
-        let samples: Vec<Vec3> = run_probe(ctx, "probe_cosine_hemisphere", n, SAMPLES, seed)
-            .iter()
-            .map(|v| Vec3::new(v[0], v[1], v[2]))
-            .collect();
+        let samples: Vec<Vec3> = run_probe(
+            ctx,
+            "probe_cosine_hemisphere",
+            probe(n, SAMPLES, seed),
+            &empty_scene(),
+        )
+        .iter()
+        .map(|v| Vec3::new(v[0], v[1], v[2]))
+        .collect();
         assert_fits(
             &format!("gpu cosine hemisphere {name}"),
             &directions(&samples, n, cosine_pdf(n), 20, 40),
@@ -109,4 +146,410 @@ fn chi2_rejects_wrong_pdfs() {
         })
         .collect();
     assert!(uniform_2d(&skewed, 32).p_value < 1e-6);
+}
+
+// ---- Light sampling ------------------------------------------------------------------------
+
+/// Two emitters of different power seen from the origin: a quad above and a sphere beside.
+const TWO_LIGHTS: &str = r#"
+[materials.quad_lamp]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+strength = 2.0
+[materials.ball_lamp]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 0.5, 0.25]
+strength = 9.0
+[[quads]]
+corner = [-1.5, 2.0, -1.0]
+u = [3.0, 0.0, 0.0]
+v = [0.0, 0.5, 3.0]
+material = "quad_lamp"
+[[spheres]]
+center = [1.5, -0.3, 1.0]
+radius = 0.8
+material = "ball_lamp"
+"#;
+
+/// A point inside an emitting sphere.
+const INSIDE_LIGHT: &str = r#"
+[materials.lamp]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+emission = [1.0, 1.0, 1.0]
+[[spheres]]
+center = [0.0, 0.0, 0.0]
+radius = 2.0
+material = "lamp"
+"#;
+
+/// The solid-angle pdf with which light sampling from `p` produces `dir`, computed here in f64
+/// from the geometry and the power-proportional selection, independently of the renderer.
+fn reference_light_pdf(scene: &glint::scene::Scene, p: glam::DVec3, dir: glam::DVec3) -> f64 {
+    use glam::DVec3;
+    let power = |material: u32| {
+        scene.materials[material as usize]
+            .emitted_radiance
+            .as_dvec3()
+            .element_sum()
+            / 3.0
+    };
+    let sphere_power: Vec<f64> = scene
+        .spheres
+        .iter()
+        .map(|s| power(s.material) * 4.0 * PI * (s.radius as f64).powi(2))
+        .collect();
+    let quad_power: Vec<f64> = scene
+        .quads
+        .iter()
+        .map(|q| power(q.material) * q.u.cross(q.v).length() as f64)
+        .collect();
+    let total: f64 = sphere_power.iter().chain(&quad_power).sum();
+    let mut pdf = 0.0;
+    for (s, w) in scene.spheres.iter().zip(&sphere_power) {
+        let (c, r) = (s.center.as_dvec3(), s.radius as f64);
+        let oc = c - p;
+        if oc.length() < r {
+            // Inside: area sampling; the exit point along dir.
+            let h = dir.dot(oc);
+            let t = h + (h * h + r * r - oc.dot(oc)).sqrt();
+            let n = (p + t * dir - c) / r;
+            pdf += w / total * t * t / (n.dot(dir).abs() * 4.0 * PI * r * r);
+        } else {
+            let cos_max = (1.0 - r * r / oc.dot(oc)).sqrt();
+            if dir.dot(oc.normalize()) >= cos_max {
+                pdf += w / total / (2.0 * PI * (1.0 - cos_max));
+            }
+        }
+    }
+    for (q, w) in scene.quads.iter().zip(&quad_power) {
+        let (corner, u, v) = (q.corner.as_dvec3(), q.u.as_dvec3(), q.v.as_dvec3());
+        let n: DVec3 = u.cross(v).normalize();
+        let t = n.dot(corner - p) / n.dot(dir);
+        if t > 0.0 {
+            let x = p + t * dir - corner;
+            let (a, b) = (x.dot(u) / u.dot(u), x.dot(v) / v.dot(v));
+            if (0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b) {
+                pdf += w / total * t * t / (n.dot(dir).abs() * u.cross(v).length());
+            }
+        }
+    }
+    pdf
+}
+
+fn light_cases() -> [(&'static str, glint::scene::Scene, Vec3); 2] {
+    [
+        (
+            "two lights",
+            common::scene(&format!("{SCENE_HEADER}{TWO_LIGHTS}")),
+            Vec3::ZERO,
+        ),
+        (
+            "inside a light",
+            common::scene(&format!("{SCENE_HEADER}{INSIDE_LIGHT}")),
+            Vec3::new(0.6, -0.4, 0.3),
+        ),
+    ]
+}
+
+/// Checks light-sampled directions (and the pdf each sample reports) against the reference.
+fn check_light_samples(name: &str, scene: &glint::scene::Scene, p: Vec3, samples: &[[f32; 4]]) {
+    let dirs: Vec<Vec3> = samples
+        .iter()
+        .map(|s| Vec3::new(s[0], s[1], s[2]))
+        .collect();
+    for (d, s) in dirs.iter().zip(samples).step_by(997) {
+        let reference = reference_light_pdf(scene, p.as_dvec3(), d.as_dvec3().normalize());
+        assert!(
+            (s[3] as f64 / reference - 1.0).abs() < 1e-3,
+            "{name}: sample pdf {} vs {reference}",
+            s[3]
+        );
+    }
+    let pdf = |d: Vec3| reference_light_pdf(scene, p.as_dvec3(), d.as_dvec3().normalize());
+    assert_fits(
+        name,
+        &directions_integrated(&dirs, Vec3::Z, pdf, 20, 40, 48),
+    );
+}
+
+#[test]
+fn cpu_light_sampling() {
+    for (k, (name, scene, p)) in light_cases().into_iter().enumerate() {
+        let kernel = scene.kernel_scene();
+        let refs = glint::cpu::trace::SceneRefs {
+            params: &kernel.params,
+            spheres: &kernel.spheres,
+            quads: &kernel.quads,
+            materials: &kernel.materials,
+            emitters: &kernel.emitters,
+        };
+        let samples: Vec<[f32; 4]> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 21 + k as u32);
+                let s = glint::cpu::lights::sample_light(&refs, p, p, &mut r);
+                [s.dir.x, s.dir.y, s.dir.z, s.pdf]
+            })
+            .collect();
+        check_light_samples(&format!("cpu light sampling, {name}"), &scene, p, &samples);
+    }
+}
+
+#[test]
+fn gpu_light_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    for (k, (name, scene, p)) in light_cases().into_iter().enumerate() {
+        let params = ProbeParams {
+            position: p.into(),
+            side_probe: p.into(),
+            ..probe(Vec3::Z, SAMPLES, SEED + 31 + k as u32)
+        };
+        let samples = run_probe(ctx, "probe_light", params, &scene.kernel_scene());
+        check_light_samples(&format!("gpu light sampling, {name}"), &scene, p, &samples);
+    }
+}
+
+// ---- Metal (GGX, visible normals) ----------------------------------------------------------
+
+/// The pdf of the reflected direction wi for GGX visible-normal sampling, G1(wo) D(h) / (4 cos θo),
+/// written here in f64 from the formulas (also for wi below the surface, which is absorbed).
+fn reference_ggx_pdf(wo: glam::DVec3, wi: glam::DVec3, n: glam::DVec3, alpha: f64) -> f64 {
+    let h = wo + wi;
+    // wi = −wo is a single point where h is undefined (a Simpson node falls exactly there).
+    if h.length() < 1e-4 {
+        return 0.0;
+    }
+    let h = h.normalize();
+    let (cos_h, cos_o) = (h.dot(n), wo.dot(n));
+    if cos_h <= 0.0 {
+        return 0.0;
+    }
+    let a2 = alpha * alpha;
+    let d = a2 / (PI * (cos_h * cos_h * (a2 - 1.0) + 1.0).powi(2));
+    let tan2 = (1.0 - cos_o * cos_o) / (cos_o * cos_o);
+    let g1 = 2.0 / (1.0 + (1.0 + a2 * tan2).sqrt());
+    g1 * d / (4.0 * cos_o)
+}
+
+fn metal_cases() -> Vec<(String, Vec3, Vec3, f32)> {
+    let n = Vec3::new(0.2, 0.9, -0.3).normalize();
+    let (t, _) = n.any_orthonormal_pair();
+    let head_on = n;
+    // cos θo = 1/2 exactly, so the discontinuity of the reference pdf (microfacet normals at
+    // the horizon, where wi · n = −wo · n) falls on a cell edge of the (cos θ, φ) grid about n.
+    let oblique = 0.5 * n + 0.75f32.sqrt() * t;
+    let mut cases = Vec::new();
+    for alpha in [0.2f32, 0.5, 1.0] {
+        for (angle, wo) in [("0°", head_on), ("60°", oblique)] {
+            cases.push((format!("alpha {alpha}, θo {angle}"), n, wo, alpha));
+        }
+    }
+    cases
+}
+
+fn check_metal_samples(name: &str, n: Vec3, wo: Vec3, alpha: f32, samples: &[[f32; 4]]) {
+    let dirs: Vec<Vec3> = samples
+        .iter()
+        .map(|s| Vec3::new(s[0], s[1], s[2]))
+        .collect();
+    for (d, s) in dirs.iter().zip(samples) {
+        // Below the surface a sample is absorbed; above it carries G2/G1 in (0, 1].
+        if d.dot(n) <= 0.0 {
+            assert_eq!(s[3], 0.0, "{name}: weight below the surface");
+        } else {
+            assert!(s[3] > 0.0 && s[3] <= 1.0 + 1e-5, "{name}: weight {}", s[3]);
+        }
+    }
+    let pdf = |d: Vec3| {
+        reference_ggx_pdf(
+            wo.as_dvec3(),
+            d.as_dvec3().normalize(),
+            n.as_dvec3(),
+            alpha as f64,
+        )
+    };
+    // Cells about n: the pdf is smooth inside every cell (its edges lie on cell edges).
+    assert_fits(name, &directions_integrated(&dirs, n, pdf, 20, 40, 48));
+}
+
+#[test]
+fn cpu_metal_sampling() {
+    for (k, (name, n, wo, alpha)) in metal_cases().into_iter().enumerate() {
+        let m = glint::shader_types::Material {
+            albedo: [1.0; 3],
+            kind: glint::shader_types::MATERIAL_METAL,
+            alpha,
+            ..Default::default()
+        };
+        let samples: Vec<[f32; 4]> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 41 + k as u32);
+                let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
+                [s.dir.x, s.dir.y, s.dir.z, s.weight.x]
+            })
+            .collect();
+        check_metal_samples(&format!("cpu metal, {name}"), n, wo, alpha, &samples);
+    }
+}
+
+#[test]
+fn gpu_metal_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    for (k, (name, n, wo, alpha)) in metal_cases().into_iter().enumerate() {
+        let params = ProbeParams {
+            wo: wo.into(),
+            alpha,
+            ..probe(n, SAMPLES, SEED + 61 + k as u32)
+        };
+        let samples = run_probe(ctx, "probe_metal", params, &empty_scene());
+        check_metal_samples(&format!("gpu metal, {name}"), n, wo, alpha, &samples);
+    }
+}
+
+// ---- Dielectric: reflection or refraction --------------------------------------------------
+
+/// Unpolarised Fresnel reflectance, f64, from the textbook formulas.
+fn reference_fresnel(cos_i: f64, eta_i: f64, eta_t: f64) -> f64 {
+    let sin_t = eta_i / eta_t * (1.0 - cos_i * cos_i).sqrt();
+    if sin_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+    let rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+    (rs * rs + rp * rp) / 2.0
+}
+
+/// (name, front face, angle of incidence in degrees); glass of ior 1.5.
+const DIELECTRIC_CASES: [(&str, bool, f32); 3] = [
+    ("entering at 30°", true, 30.0),
+    ("entering at 80°", true, 80.0),
+    ("leaving at 20°", false, 20.0),
+];
+const GLASS_IOR: f32 = 1.5;
+
+/// Reflection happens with the Fresnel probability (binomial χ² on the two outcomes), every
+/// reflection is the mirror direction, and every refraction obeys Snell's law.
+fn check_dielectric_samples(
+    name: &str,
+    front: bool,
+    degrees: f32,
+    n: Vec3,
+    wo: Vec3,
+    samples: &[[f32; 4]],
+) {
+    let (eta_i, eta_t) = if front {
+        (1.0, GLASS_IOR as f64)
+    } else {
+        (GLASS_IOR as f64, 1.0)
+    };
+    let cos_i = (degrees as f64).to_radians().cos();
+    let reflectance = reference_fresnel(cos_i, eta_i, eta_t);
+    let mut reflected = 0u64;
+    for s in samples {
+        let d = Vec3::new(s[0], s[1], s[2]).as_dvec3();
+        let n = n.as_dvec3();
+        if d.dot(n) > 0.0 {
+            reflected += 1;
+            let mirror = 2.0 * wo.as_dvec3().dot(n) * n - wo.as_dvec3();
+            assert!(
+                (d - mirror).length() < 1e-5,
+                "{name}: reflection {d} vs {mirror}"
+            );
+        } else {
+            let sin_t = (1.0 - d.dot(n).powi(2)).sqrt();
+            let sin_i = (1.0 - cos_i * cos_i).sqrt();
+            assert!(
+                (eta_i * sin_i - eta_t * sin_t).abs() < 1e-5,
+                "{name}: Snell"
+            );
+        }
+    }
+    let total = samples.len() as f64;
+    let result = pearson(
+        &[reflected, samples.len() as u64 - reflected],
+        &[total * reflectance, total * (1.0 - reflectance)],
+    );
+    eprintln!(
+        "{name}: reflected {:.5} of samples, Fresnel {reflectance:.5}",
+        reflected as f64 / total
+    );
+    assert_fits(name, &Ok(result));
+}
+
+fn dielectric_geometry(degrees: f32) -> (Vec3, Vec3) {
+    let n = Vec3::new(-0.4, 0.1, 0.9).normalize();
+    let (t, _) = n.any_orthonormal_pair();
+    let theta = degrees.to_radians();
+    (n, (theta.cos() * n + theta.sin() * t).normalize())
+}
+
+fn glass(front_face: bool) -> glint::shader_types::Material {
+    let _ = front_face;
+    glint::shader_types::Material {
+        albedo: [1.0; 3],
+        kind: glint::shader_types::MATERIAL_DIELECTRIC,
+        ior: GLASS_IOR,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn cpu_dielectric_choice() {
+    for (k, (name, front, degrees)) in DIELECTRIC_CASES.into_iter().enumerate() {
+        let (n, wo) = dielectric_geometry(degrees);
+        let samples: Vec<[f32; 4]> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 81 + k as u32);
+                let s = glint::cpu::material::bsdf_sample(&glass(front), wo, n, front, &mut r);
+                [s.dir.x, s.dir.y, s.dir.z, s.weight.x]
+            })
+            .collect();
+        check_dielectric_samples(
+            &format!("cpu glass, {name}"),
+            front,
+            degrees,
+            n,
+            wo,
+            &samples,
+        );
+    }
+}
+
+#[test]
+fn gpu_dielectric_choice() {
+    let Some(ctx) = common::gpu() else { return };
+    for (k, (name, front, degrees)) in DIELECTRIC_CASES.into_iter().enumerate() {
+        let (n, wo) = dielectric_geometry(degrees);
+        let params = ProbeParams {
+            wo: wo.into(),
+            ior: GLASS_IOR,
+            front_face: front as u32,
+            ..probe(n, SAMPLES, SEED + 91 + k as u32)
+        };
+        let samples = run_probe(ctx, "probe_dielectric", params, &empty_scene());
+        check_dielectric_samples(
+            &format!("gpu glass, {name}"),
+            front,
+            degrees,
+            n,
+            wo,
+            &samples,
+        );
+    }
+}
+
+/// Beyond the critical angle (41.8° leaving glass of ior 1.5) every sample reflects: a
+/// refraction there would be a sample where the pdf is 0.
+#[test]
+fn total_internal_reflection_always_reflects() {
+    let (n, wo) = dielectric_geometry(60.0);
+    for i in 0..100_000 {
+        let mut r = cpu_draws(i, SEED);
+        let s = glint::cpu::material::bsdf_sample(&glass(false), wo, n, false, &mut r);
+        assert!(s.dir.dot(n) > 0.0, "refracted beyond the critical angle");
+        assert_eq!(s.weight, Vec3::ONE);
+    }
 }

@@ -1,18 +1,25 @@
 //! Runs the WGSL sampling routines on the GPU through tests/shaders/probe.wgsl.
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
 use glint::gpu::GpuContext;
+use glint::scene::KernelScene;
 use glint::shader::render_kernel_source;
 use wgpu::util::DeviceExt;
 
+/// The probe kernel's parameters (tests/shaders/probe.wgsl).
 #[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct ProbeParams {
-    normal: [f32; 3],
-    count: u32,
-    seed: u32,
-    _pad: [u32; 3],
+#[derive(Clone, Copy, Default, Pod, Zeroable)]
+pub struct ProbeParams {
+    pub normal: [f32; 3],
+    pub count: u32,
+    pub wo: [f32; 3],
+    pub seed: u32,
+    pub position: [f32; 3],
+    pub alpha: f32,
+    pub side_probe: [f32; 3],
+    pub ior: f32,
+    pub front_face: u32,
+    pub _pad: [u32; 3],
 }
 
 pub const PROBE_SOURCE: &str = include_str!("../shaders/probe.wgsl");
@@ -21,39 +28,88 @@ pub fn probe_module_source() -> String {
     render_kernel_source() + PROBE_SOURCE
 }
 
-/// Runs the probe entry point `entry` for `count` samples and returns what it wrote.
+fn storage<T: Pod + Default>(ctx: &GpuContext, items: &[T]) -> wgpu::Buffer {
+    let placeholder = [T::default()];
+    let items = if items.is_empty() {
+        &placeholder[..]
+    } else {
+        items
+    };
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(items),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+}
+
+fn layout_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Runs the probe entry point `entry` for `params.count` samples, with `scene` bound as the
+/// kernel's scene (light sampling reads it), and returns what it wrote.
 pub fn run_probe(
     ctx: &GpuContext,
     entry: &str,
-    normal: Vec3,
-    count: u32,
-    seed: u32,
+    params: ProbeParams,
+    scene: &KernelScene,
 ) -> Vec<[f32; 4]> {
     let device = &ctx.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("probe"),
         source: wgpu::ShaderSource::Wgsl(probe_module_source().into()),
     });
+    // An explicit layout with every scene binding, whichever the entry point uses.
+    let read_only = wgpu::BufferBindingType::Storage { read_only: true };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: None,
+        entries: &[
+            layout_entry(0, wgpu::BufferBindingType::Uniform),
+            layout_entry(1, read_only),
+            layout_entry(2, read_only),
+            layout_entry(3, read_only),
+            layout_entry(6, read_only),
+            layout_entry(10, wgpu::BufferBindingType::Uniform),
+            layout_entry(11, wgpu::BufferBindingType::Storage { read_only: false }),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: None,
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
     let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(entry),
-        layout: None,
+        layout: Some(&pipeline_layout),
         module: &module,
         entry_point: Some(entry),
         compilation_options: Default::default(),
         cache: None,
     });
-    let params = ProbeParams {
-        normal: normal.into(),
-        count,
-        seed,
-        _pad: [0; 3],
+    let uniform = |bytes: &[u8]| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
     };
-    let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("probe params"),
-        contents: bytemuck::bytes_of(&params),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let size = count as u64 * 16;
+    let scene_params = uniform(bytemuck::bytes_of(&scene.params));
+    let probe_params = uniform(bytemuck::bytes_of(&params));
+    let spheres = storage(ctx, &scene.spheres);
+    let quads = storage(ctx, &scene.quads);
+    let materials = storage(ctx, &scene.materials);
+    let emitters = storage(ctx, &scene.emitters);
+    let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
         size,
@@ -68,24 +124,27 @@ pub fn run_probe(
     });
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
-        layout: &pipeline.get_bind_group_layout(0),
+        layout: &layout,
         entries: &[
-            wgpu::BindGroupEntry {
-                binding: 10,
-                resource: params_buffer.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 11,
-                resource: out.as_entire_binding(),
-            },
-        ],
+            (0, &scene_params),
+            (1, &spheres),
+            (2, &quads),
+            (3, &materials),
+            (6, &emitters),
+            (10, &probe_params),
+            (11, &out),
+        ]
+        .map(|(binding, buffer)| wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        }),
     });
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(count.div_ceil(256), 1, 1);
+        pass.dispatch_workgroups(params.count.div_ceil(256), 1, 1);
     }
     encoder.copy_buffer_to_buffer(&out, 0, &readback, 0, None);
     ctx.queue.submit([encoder.finish()]);

@@ -5,7 +5,14 @@
 struct ProbeParams {
     normal: vec3<f32>,
     count: u32,
+    wo: vec3<f32>,
     seed: u32,
+    position: vec3<f32>,
+    alpha: f32,
+    // `position` moved off the surface to the side light arrives from (see sample_light).
+    side_probe: vec3<f32>,
+    ior: f32,
+    front_face: u32,
 }
 
 @group(0) @binding(10) var<uniform> probe: ProbeParams;
@@ -28,4 +35,47 @@ fn probe_cosine_hemisphere(@builtin(global_invocation_id) id: vec3<u32>) {
     var rng = rng_init(id.x, 0u, 1u, probe.seed);
     let u = vec2<f32>(rng_next(&rng), rng_next(&rng));
     probe_out[id.x] = vec4<f32>(sample_cosine_hemisphere(probe.normal, u), 0.0);
+}
+
+// Light sampling from probe.position in the bound scene: direction and pdf.
+@compute @workgroup_size(256, 1, 1)
+fn probe_light(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let light = sample_light(probe.position, probe.side_probe, &rng);
+    probe_out[id.x] = vec4<f32>(light.dir, light.pdf);
+}
+
+// The BSDF sampled for a material built from the probe parameters: direction, and in w the
+// sample's weight (x channel) with the sign of `is_delta` folded into a flag: w = weight for
+// non-delta samples, -1 - weight for delta ones.
+fn probe_material(kind: u32) -> Material {
+    var m: Material;
+    m.albedo = vec3<f32>(1.0);
+    m.kind = kind;
+    m.alpha = probe.alpha;
+    m.ior = probe.ior;
+    return m;
+}
+
+@compute @workgroup_size(256, 1, 1)
+fn probe_metal(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let s = bsdf_sample(probe_material(MATERIAL_METAL), probe.wo, probe.normal, true, &rng);
+    probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
+}
+
+@compute @workgroup_size(256, 1, 1)
+fn probe_dielectric(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let s = bsdf_sample(probe_material(MATERIAL_DIELECTRIC), probe.wo, probe.normal, probe.front_face != 0u, &rng);
+    probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
