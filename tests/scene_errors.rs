@@ -315,3 +315,82 @@ fn reflectance_above_one_and_negative_emission() {
         &["≥ 0"],
     );
 }
+
+#[test]
+fn new_material_and_camera_fields() {
+    let metal = |extra: &str| {
+        edited(
+            "type = \"diffuse\"\ncolor = [0.7, 0.7, 0.7]",
+            &format!("type = \"metal\"\ncolor = [0.7, 0.7, 0.7]\n{extra}"),
+        )
+    };
+    assert!(parse(&metal("roughness = 0.3")).is_ok());
+    assert_error(
+        &metal("roughness = 1.5"),
+        Some(16),
+        &["materials.white.roughness", "[0, 1]"],
+    );
+    assert_error(
+        &metal("roughness = -0.1"),
+        Some(16),
+        &["materials.white.roughness"],
+    );
+    assert_error(
+        &metal(""),
+        Some(14),
+        &["materials.white.roughness", "missing"],
+    );
+    let glass = |extra: &str| {
+        edited(
+            "type = \"diffuse\"\ncolor = [0.7, 0.7, 0.7]",
+            &format!("type = \"dielectric\"\n{extra}"),
+        )
+    };
+    let s = parse(&glass("ior = 1.5")).unwrap();
+    // A clear glass unless tinted.
+    assert_eq!(
+        s.materials
+            .iter()
+            .find(|m| m.name == "white")
+            .unwrap()
+            .color,
+        glam::Vec3::ONE
+    );
+    assert_error(
+        &glass("ior = 0.0"),
+        Some(15),
+        &["materials.white.ior", "> 0"],
+    );
+    assert_error(&glass("ior = -1.5"), Some(15), &["materials.white.ior"]);
+    assert_error(&glass(""), Some(14), &["materials.white.ior", "missing"]);
+    assert_error(
+        &edited(
+            "color = [0.7, 0.7, 0.7]",
+            "color = [0.7, 0.7, 0.7]\nior = 1.5",
+        ),
+        Some(16),
+        &["ior does not apply to a diffuse"],
+    );
+    assert_error(
+        &edited("vfov = 40.0", "vfov = 40.0\naperture = -1.0"),
+        Some(6),
+        &["camera.aperture"],
+    );
+    assert_error(
+        &edited("vfov = 40.0", "vfov = 40.0\nfocus_distance = 0.0"),
+        Some(6),
+        &["camera.focus_distance", "> 0"],
+    );
+    let s = parse(&edited("vfov = 40.0", "vfov = 40.0\naperture = 0.2")).unwrap();
+    assert_eq!(s.camera.aperture, 0.2);
+    // The focus distance defaults to the distance from the eye to the target.
+    assert_eq!(s.camera.focus_distance, 5.0);
+    assert_error(
+        &edited(
+            "max_bounces = 4",
+            "max_bounces = 4\nlight_sampling = \"yes\"",
+        ),
+        Some(12),
+        &["TOML"],
+    );
+}

@@ -4,9 +4,11 @@
 //!
 //! Why the thresholds are what they are:
 //! - Each pixel channel's mean is approximately normal, so |z| ≤ 2.576 holds for 99% of them
-//!   when two renders estimate the same image. We measured 99.7% (the pixel distributions are
-//!   skewed and the channels correlated) and require 98%: a renderer that is wrong in a part of
-//!   the image (a missing light path, a wrong material) fails far more pixels than that.
+//!   when two renders estimate the same image. The pixel distributions are skewed (paths that
+//!   find the light through the mirror are rare) and the channels correlated, so the rate
+//!   varies around that: we measured 98.2% to 99.7% across the tests below, and require 97%.
+//!   A renderer that is wrong in a part of the image (a missing light path, a wrong material
+//!   on one object) fails more pixels than that.
 //! - A bias small in every pixel but common to all (a wrong constant factor) barely moves the
 //!   pass rate, so we also test the difference of the image means, whose variance is the sum
 //!   of all pixel variances / N²: |z| < 4 (two-sided false alarm 6·10⁻⁵ per test). At 256 spp
@@ -22,7 +24,7 @@ use glint::render::Renderer;
 use glint::scene::{KernelScene, RenderOverrides, Scene};
 use std::path::Path;
 
-const MIN_PASS_RATE: f64 = 0.98;
+const MIN_PASS_RATE: f64 = 0.97;
 const MAX_Z_OF_MEANS: f64 = 4.0;
 
 fn cornell_64(seed: u32) -> KernelScene {
@@ -254,4 +256,27 @@ material = "lamp"
     );
     assert!(estimated <= target);
     assert!((real / target - 1.0).abs() < 0.25, "real error {real}");
+}
+
+/// Light sampling changes the variance, not the expectation: the Cornell box rendered with and
+/// without it (4096 spp each, GPU, different seeds) passes the same Z-tests. Both need 4096 spp
+/// for their pixel means to be close enough to normal: paths that find the light only through
+/// the mirror sphere are rare in both modes. With fewer samples we measured a 97.5% pass rate
+/// (2048 spp each) and, with light sampling at 1024 spp, a z of means of 3.3, while each mode
+/// at 4096 spp stays within 1σ of the committed reference. A light-sampling estimator that
+/// double-counts or drops the directly seen light shifts the image mean by tens of σ.
+#[test]
+fn light_sampling_on_and_off_converge_to_the_same_image() {
+    let Some(ctx) = gpu() else { return };
+    let mut on = cornell_64(21);
+    on.params.light_sampling = 1;
+    let mut off = cornell_64(22);
+    off.params.light_sampling = 0;
+    let a = render(&mut GpuRenderer::new(ctx, &on).unwrap(), 4096);
+    let b = render(&mut GpuRenderer::new(ctx, &off).unwrap(), 4096);
+    assert_same_image("light sampling on vs off", &z_test(&a, &b));
+    // Light sampling is the lower-variance estimator here.
+    let (va, vb) = (a.1.mean(), b.1.mean());
+    eprintln!("variance of the pixel means at 4096 spp: on {va:.3e}, off {vb:.3e}");
+    assert!(va < vb);
 }
