@@ -1,6 +1,9 @@
 // Path tracing kernel (mirror: src/cpu/trace.rs): one invocation per pixel adds
 // params.sample_count samples, starting at global sample index params.sample_start.
 
+// Segments this invocation traced; added to `segments_traced` once at the end.
+var<private> segments: u32 = 0u;
+
 fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
     var camera_rng = rng_init(pixel, sample, 0u, params.seed);
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
@@ -17,6 +20,7 @@ fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
     // max_bounces counts scattering events; the loop bound also caps a corrupt value.
     for (var bounce = 0u; bounce <= params.max_bounces; bounce++) {
         let hit = intersect_scene(ray);
+        segments += 1u;
         if hit.t == NO_HIT {
             radiance += throughput * params.background;
             break;
@@ -46,6 +50,7 @@ fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
                 let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
                 if any(f_cos > vec3<f32>(0.0)) {
                     let blocker = intersect_scene(Ray(origin, light.dir));
+                    segments += 1u;
                     if blocker.t != NO_HIT && blocker.primitive == light.primitive && blocker.index == light.index {
                         let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
                         radiance += throughput * f_cos * light.radiance * (weight / light.pdf);
@@ -102,4 +107,5 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
     let delta = mean - old_mean;
     accum_mean[pixel] = vec4<f32>(old_mean + delta * (n_new / n), 0.0);
     accum_m2[pixel] = vec4<f32>(accum_m2[pixel].xyz + m2 + delta * delta * (n_old * n_new / n), 0.0);
+    atomicAdd(&segments_traced, segments);
 }

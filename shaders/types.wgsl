@@ -102,3 +102,6 @@ struct Ray {
 @group(0) @binding(4) var<storage, read_write> accum_mean: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> accum_m2: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> emitters: array<Emitter>;
+// Ray segments traced (camera, bounce and shadow rays), for benchmarks; wraps at 2^32, so the
+// host reads and clears it after each batch when it wants the figure.
+@group(0) @binding(7) var<storage, read_write> segments_traced: atomic<u32>;

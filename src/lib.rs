@@ -4,6 +4,7 @@
 //! Data flows one way: scene file → [`scene::Scene`] (validated) → [`scene::KernelScene`]
 //! (the kernel's structs) → a [`render::Renderer`] (GPU or CPU) → [`output::Image`].
 
+pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod cpu;

@@ -20,6 +20,16 @@ pub trait Renderer {
     fn read_variance(&mut self) -> Result<Image>;
     /// Forgets all samples.
     fn reset(&mut self) -> Result<()>;
+    /// Ray segments traced since the last reset (camera, bounce and shadow rays), where the
+    /// renderer counts them (the GPU one only when instrumented).
+    fn segments_traced(&self) -> Option<u64> {
+        None
+    }
+    /// Device time of the last batch's kernel, where the device measures it (GPU timestamp
+    /// queries, when instrumented).
+    fn last_kernel_time(&self) -> Option<Duration> {
+        None
+    }
     /// Adapter name, or "cpu".
     fn device_name(&self) -> String;
     fn backend_name(&self) -> String;

@@ -1,5 +1,6 @@
 //! The `glint` command line.
 
+mod bench;
 mod compare;
 mod render;
 mod view;
@@ -25,6 +26,8 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Compare two EXR renders: error metrics and, with variance images, per-pixel Z-tests.
     Compare(compare::CompareArgs),
+    /// Measure paths/s on the GPU and the CPU reference (Cornell box, 256² and 512²).
+    Bench(bench::BenchArgs),
     /// Open a window that renders the scene progressively; fly around, watch it refine, save.
     View(view::ViewArgs),
 }
@@ -39,6 +42,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::View(args) => view::run(args),
     };
     match result {

@@ -11,6 +11,7 @@ pub struct CpuRenderer {
     scene: KernelScene,
     stats: Vec<PixelStats>,
     samples: u32,
+    segments: u64,
 }
 
 impl CpuRenderer {
@@ -20,6 +21,7 @@ impl CpuRenderer {
             scene: scene.clone(),
             stats: vec![PixelStats::default(); pixels],
             samples: 0,
+            segments: 0,
         }
     }
 
@@ -45,15 +47,20 @@ impl Renderer for CpuRenderer {
             emitters: &self.scene.emitters,
         };
         let width = params.width as usize;
-        self.stats
+        let segments: u64 = self
+            .stats
             .par_chunks_mut(width)
             .enumerate()
-            .for_each(|(y, row)| {
+            .map(|(y, row)| {
+                let mut segments = 0u64;
                 for (x, stats) in row.iter_mut().enumerate() {
-                    render_pixel(&refs, x as u32, y as u32, stats);
+                    segments += render_pixel(&refs, x as u32, y as u32, stats) as u64;
                 }
-            });
+                segments
+            })
+            .sum();
         self.samples += count;
+        self.segments += segments;
         Ok(())
     }
 
@@ -73,7 +80,12 @@ impl Renderer for CpuRenderer {
     fn reset(&mut self) -> Result<()> {
         self.stats.fill(PixelStats::default());
         self.samples = 0;
+        self.segments = 0;
         Ok(())
+    }
+
+    fn segments_traced(&self) -> Option<u64> {
+        Some(self.segments)
     }
 
     fn device_name(&self) -> String {

@@ -18,8 +18,16 @@ pub struct SceneRefs<'a> {
     pub emitters: &'a [Emitter],
 }
 
-/// Radiance carried by one camera path through pixel (px, py).
-pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) -> Vec3 {
+/// Radiance carried by one camera path through pixel (px, py); `segments` counts the ray
+/// segments traced (camera, bounce and shadow rays), as the kernel's counter does.
+pub fn trace_path(
+    scene: &SceneRefs,
+    pixel: u32,
+    px: u32,
+    py: u32,
+    sample: u32,
+    segments: &mut u32,
+) -> Vec3 {
     let params = scene.params;
     let mut camera_rng = Rng::new(pixel, sample, 0, params.seed);
     let jitter = (camera_rng.next_f32(), camera_rng.next_f32());
@@ -37,6 +45,7 @@ pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) 
     // max_bounces counts scattering events.
     for bounce in 0..=params.max_bounces {
         let hit = intersect_scene(scene.spheres, scene.quads, &ray);
+        *segments += 1;
         if hit.t == NO_HIT {
             radiance += throughput * background;
             break;
@@ -82,6 +91,7 @@ pub fn trace_path(scene: &SceneRefs, pixel: u32, px: u32, py: u32, sample: u32) 
                             dir: light.dir,
                         },
                     );
+                    *segments += 1;
                     if blocker.t != NO_HIT
                         && blocker.primitive == light.primitive
                         && blocker.index == light.index
@@ -140,15 +150,16 @@ pub struct PixelStats {
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
 /// `params.sample_start`, merged into `stats`, which holds the `params.sample_start` samples
-/// before them.
-pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) {
+/// before them. Returns the ray segments traced.
+pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
     let params = scene.params;
     let pixel = py * params.width + px;
     // Welford over this batch's samples...
     let mut mean = Vec3::ZERO;
     let mut m2 = Vec3::ZERO;
+    let mut segments = 0;
     for i in 0..params.sample_count {
-        let x = trace_path(scene, pixel, px, py, params.sample_start + i);
+        let x = trace_path(scene, pixel, px, py, params.sample_start + i, &mut segments);
         let delta = x - mean;
         mean += delta / (i + 1) as f32;
         m2 += delta * (x - mean);
@@ -160,4 +171,5 @@ pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats)
     let delta = mean - stats.mean;
     stats.mean += delta * (n_new / n);
     stats.m2 = stats.m2 + m2 + delta * delta * (n_old * n_new / n);
+    segments
 }

@@ -22,6 +22,20 @@ pub struct GpuRenderer<'a> {
     m2_buffer: wgpu::Buffer,
     readback_buffer: wgpu::Buffer,
     samples: u32,
+    /// The kernel's segment counter (one u32).
+    counter_buffer: wgpu::Buffer,
+    /// Benchmark instrumentation, off unless asked for: it reads back after every batch.
+    instruments: Option<Instruments>,
+}
+
+/// Timestamp queries and the segment count, read after each batch.
+struct Instruments {
+    /// Two timestamps around the render pass, where the device supports them.
+    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    /// Counter and timestamps land here for readback: [segments: u32, pad: u32, t0: u64, t1: u64].
+    readback: wgpu::Buffer,
+    segments: u64,
+    last_kernel_time: Option<std::time::Duration>,
 }
 
 /// A read-only storage buffer holding `items`; bindings cannot be empty, so an empty list
@@ -88,6 +102,14 @@ impl<'a> GpuRenderer<'a> {
                 mapped_at_creation: false,
             })
         };
+        let counter_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("segments_traced"),
+            size: 8,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let mean_buffer = accumulator("accum_mean");
         let m2_buffer = accumulator("accum_m2");
         let readback_buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -107,6 +129,7 @@ impl<'a> GpuRenderer<'a> {
                 (4, &mean_buffer),
                 (5, &m2_buffer),
                 (6, &emitters),
+                (7, &counter_buffer),
             ]
             .map(|(binding, buffer)| wgpu::BindGroupEntry {
                 binding,
@@ -124,7 +147,84 @@ impl<'a> GpuRenderer<'a> {
             m2_buffer,
             readback_buffer,
             samples: 0,
+            counter_buffer,
+            instruments: None,
         })
+    }
+
+    /// Turns on benchmark instrumentation: after every batch, the renderer reads back the
+    /// number of ray segments traced and, where the device has timestamp queries, the
+    /// kernel's device time. This adds a small readback per batch, so renders leave it off.
+    pub fn instrument(&mut self) {
+        let device = &self.ctx.device;
+        let timestamps = self
+            .ctx
+            .features
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| {
+                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("kernel time"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2,
+                });
+                let resolve = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("kernel time resolve"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                });
+                (set, resolve)
+            });
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("instrument readback"),
+            size: 24,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.instruments = Some(Instruments {
+            timestamps,
+            readback,
+            segments: 0,
+            last_kernel_time: None,
+        });
+    }
+
+    /// Reads the counter and timestamps of the batch just submitted, and clears the counter.
+    fn read_instruments(&mut self) -> Result<()> {
+        let Some(instruments) = &mut self.instruments else {
+            return Ok(());
+        };
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.counter_buffer, 0, &instruments.readback, 0, 8);
+        if let Some((_, resolve)) = &instruments.timestamps {
+            encoder.copy_buffer_to_buffer(resolve, 0, &instruments.readback, 8, 16);
+        }
+        encoder.clear_buffer(&self.counter_buffer, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        let slice = instruments.readback.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.ctx.wait_idle()?;
+        rx.recv()
+            .map_err(|_| anyhow!("GPU readback was dropped"))?
+            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+        let (segments, t0, t1) = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+            let words: &[u32] = bytemuck::cast_slice(&view[..8]);
+            let stamps: &[u64] = bytemuck::cast_slice(&view[8..24]);
+            (words[0], stamps[0], stamps[1])
+        };
+        instruments.readback.unmap();
+        instruments.segments += segments as u64;
+        if instruments.timestamps.is_some() && t1 > t0 {
+            let ns = (t1 - t0) as f64 * self.ctx.queue.get_timestamp_period() as f64;
+            instruments.last_kernel_time = Some(std::time::Duration::from_nanos(ns as u64));
+        }
+        Ok(())
     }
 
     /// The per-pixel mean radiance (vec4 per pixel, xyz used), for display passes that read it
@@ -195,10 +295,18 @@ impl Renderer for GpuRenderer<'_> {
             .queue
             .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        let timestamps = self
+            .instruments
+            .as_ref()
+            .and_then(|i| i.timestamps.as_ref());
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("render"),
-                timestamp_writes: None,
+                timestamp_writes: timestamps.map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.bind_group, &[]);
@@ -208,10 +316,13 @@ impl Renderer for GpuRenderer<'_> {
                 1,
             );
         }
+        if let Some((set, resolve)) = timestamps {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+        }
         self.ctx.queue.submit([encoder.finish()]);
         self.ctx.wait_idle()?;
         self.samples += count;
-        Ok(())
+        self.read_instruments()
     }
 
     fn samples(&self) -> u32 {
@@ -232,9 +343,21 @@ impl Renderer for GpuRenderer<'_> {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&self.mean_buffer, 0, None);
         encoder.clear_buffer(&self.m2_buffer, 0, None);
+        encoder.clear_buffer(&self.counter_buffer, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.samples = 0;
+        if let Some(instruments) = &mut self.instruments {
+            instruments.segments = 0;
+        }
         self.ctx.wait_idle()
+    }
+
+    fn segments_traced(&self) -> Option<u64> {
+        self.instruments.as_ref().map(|i| i.segments)
+    }
+
+    fn last_kernel_time(&self) -> Option<std::time::Duration> {
+        self.instruments.as_ref().and_then(|i| i.last_kernel_time)
     }
 
     fn device_name(&self) -> String {

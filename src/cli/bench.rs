@@ -1,0 +1,121 @@
+//! `glint bench`.
+
+use crate::bench::{case_scene, cases, run_case, BenchDevice, BenchResult};
+use crate::cpu::renderer::CpuRenderer;
+use crate::gpu::{GpuContext, GpuRenderer};
+use anyhow::Result;
+use clap::Args;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Timed runs per configuration (after one warm-up batch); the figures are medians.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub runs: u32,
+    /// Benchmark the GPU only.
+    #[arg(long, conflicts_with = "cpu_only")]
+    pub gpu_only: bool,
+    /// Benchmark the CPU reference only.
+    #[arg(long)]
+    pub cpu_only: bool,
+    /// A smoke test: tiny images, 2 spp, for checking that the benchmark runs.
+    #[arg(long)]
+    pub quick: bool,
+    /// Print the figures as JSON on stdout instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: BenchArgs) -> Result<()> {
+    let gpu = if args.cpu_only {
+        None
+    } else {
+        Some(GpuContext::new()?)
+    };
+    let gpu_name = gpu.as_ref().map(|g| g.device_name());
+    if !args.json {
+        println!(
+            "GPU: {}   CPU reference: {} threads   (medians of {} runs after a warm-up)",
+            gpu_name.as_deref().unwrap_or("none"),
+            rayon::current_num_threads(),
+            args.runs
+        );
+    }
+    let mut results = Vec::new();
+    for case in cases(args.quick) {
+        let scene = case_scene(&case);
+        let result = match (case.device, &gpu) {
+            (BenchDevice::Gpu, Some(ctx)) => {
+                let mut renderer = GpuRenderer::new(ctx, &scene)?;
+                renderer.instrument();
+                run_case(&mut renderer, case, args.runs as usize)?
+            }
+            (BenchDevice::Cpu, _) if !args.gpu_only => {
+                run_case(&mut CpuRenderer::new(&scene), case, args.runs as usize)?
+            }
+            _ => continue,
+        };
+        if !args.json {
+            if results.is_empty() {
+                println!("{}", header());
+            }
+            println!("{}", row(&result));
+        }
+        results.push(result);
+    }
+    if args.json {
+        let rows: Vec<_> = results
+            .iter()
+            .map(|r| {
+                serde_json::json!({
+                    "device": r.case.device.as_str(),
+                    "width": r.case.size,
+                    "height": r.case.size,
+                    "max_bounces": 8,
+                    "light_sampling": r.case.light_sampling,
+                    "spp_per_run": r.case.spp,
+                    "spp_per_batch": r.case.batch_spp,
+                    "runs": r.runs,
+                    "paths_per_second": r.paths_per_second,
+                    "rays_per_second": r.rays_per_second,
+                    "segments_per_path": r.segments_per_path,
+                    "ms_per_batch": r.ms_per_batch,
+                    "kernel_ms_per_batch": r.kernel_ms_per_batch,
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({
+                "gpu": gpu_name,
+                "gpu_backend": gpu.as_ref().map(|g| g.backend_name()),
+                "cpu_threads": rayon::current_num_threads(),
+                "results": rows,
+            })
+        );
+    }
+    Ok(())
+}
+
+fn header() -> String {
+    format!(
+        "{:<6} {:>9} {:>6} {:>14} {:>14} {:>10} {:>10} {:>12}",
+        "device", "size", "light", "paths/s", "rays/s", "rays/path", "ms/batch", "kernel ms"
+    )
+}
+
+fn row(r: &BenchResult) -> String {
+    let opt = |v: Option<f64>, scale: f64, digits: usize| {
+        v.map_or("-".to_string(), |v| format!("{:.*}", digits, v / scale))
+    };
+    format!(
+        "{:<6} {:>9} {:>6} {:>12.2} M {:>12} M {:>10} {:>10.1} {:>12}",
+        r.case.device.as_str(),
+        format!("{}²", r.case.size),
+        if r.case.light_sampling { "on" } else { "off" },
+        r.paths_per_second / 1e6,
+        opt(r.rays_per_second, 1e6, 2),
+        opt(r.segments_per_path, 1.0, 2),
+        r.ms_per_batch,
+        opt(r.kernel_ms_per_batch, 1.0, 1),
+    )
+}
