@@ -4,100 +4,137 @@
 // Segments this invocation traced; added to `segments_traced` once at the end.
 var<private> segments: u32 = 0u;
 
-fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
+// A path in flight: what one more segment needs.
+struct PathState {
+    ray: Ray,
+    throughput: vec3<f32>,
+    radiance: vec3<f32>,
+    // The surface point the current ray left from (light pdfs are evaluated there).
+    ray_start: vec3<f32>,
+    // How the current ray was sampled, for weighting the emitter it may hit.
+    bsdf_pdf_of_ray: f32,
+    bounce: u32,
+    came_from_delta: bool,
+}
+
+fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
     var camera_rng = rng_init(pixel, sample, 0u, params.seed);
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
-    var ray = camera_ray(px, py, jitter, lens);
-    var throughput = vec3<f32>(1.0);
-    var radiance = vec3<f32>(0.0);
-    // How the current ray was sampled, for weighting the emitter it may hit.
-    var came_from_delta = true;
-    var bsdf_pdf_of_ray = 0.0;
-    // The surface point the current ray left from (light pdfs are evaluated there).
-    var ray_start = ray.origin;
+    let ray = camera_ray(px, py, jitter, lens);
+    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true);
+}
+
+// Traces one segment of the path (and its shadow ray); true when the path has ended.
+fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
+    let ray = (*path).ray;
+    let bounce = (*path).bounce;
     let light_sampling = params.light_sampling != 0u && params.emitter_count > 0u;
-    // max_bounces counts scattering events; the loop bound also caps a corrupt value.
-    for (var bounce = 0u; bounce <= params.max_bounces; bounce++) {
-        let hit = intersect_scene(ray);
-        segments += 1u;
-        if hit.t == NO_HIT {
-            radiance += throughput * params.background;
-            break;
+    let hit = intersect_scene(ray);
+    segments += 1u;
+    if hit.t == NO_HIT {
+        (*path).radiance += (*path).throughput * params.background;
+        return true;
+    }
+    let m = materials[hit.material];
+    if any(m.emission > vec3<f32>(0.0)) {
+        // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
+        // from the previous vertex; camera rays and delta bounces count in full.
+        var weight = 1.0;
+        if light_sampling && !(*path).came_from_delta {
+            let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
+            weight = power_heuristic((*path).bsdf_pdf_of_ray, pdf);
         }
-        let m = materials[hit.material];
-        if any(m.emission > vec3<f32>(0.0)) {
-            // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
-            // from the previous vertex; camera rays and delta bounces count in full.
-            var weight = 1.0;
-            if light_sampling && !came_from_delta {
-                let pdf = light_pdf(ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
-                weight = power_heuristic(bsdf_pdf_of_ray, pdf);
-            }
-            radiance += throughput * m.emission * weight;
-        }
-        if bounce == params.max_bounces {
-            break;
-        }
-        let p = hit.position;
-        let wo = -ray.dir;
-        let origin = offset_ray_origin(p, hit.normal);
-        if light_sampling && !is_delta(m) {
-            // Next-event estimation: light arriving after one more scattering event.
-            var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
-            let light = sample_light(p, origin, &light_rng);
-            if light.pdf > 0.0 {
-                let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
-                if any(f_cos > vec3<f32>(0.0)) {
-                    let blocker = intersect_scene(Ray(origin, light.dir));
-                    segments += 1u;
-                    if blocker.t != NO_HIT && blocker.primitive == light.primitive && blocker.index == light.index {
-                        let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
-                        radiance += throughput * f_cos * light.radiance * (weight / light.pdf);
-                    }
+        (*path).radiance += (*path).throughput * m.emission * weight;
+    }
+    // max_bounces counts scattering events; this also bounds every path's length.
+    if bounce >= params.max_bounces {
+        return true;
+    }
+    let p = hit.position;
+    let wo = -ray.dir;
+    let origin = offset_ray_origin(p, hit.normal);
+    if light_sampling && !is_delta(m) {
+        // Next-event estimation: light arriving after one more scattering event.
+        var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
+        let light = sample_light(p, origin, &light_rng);
+        if light.pdf > 0.0 {
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
+            if any(f_cos > vec3<f32>(0.0)) {
+                let blocker = intersect_scene(Ray(origin, light.dir));
+                segments += 1u;
+                if blocker.t != NO_HIT && blocker.primitive == light.primitive && blocker.index == light.index {
+                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                    (*path).radiance += (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
                 }
             }
         }
-        var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
-        let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &bsdf_rng);
-        throughput *= s.weight;
-        if all(throughput == vec3<f32>(0.0)) {
+    }
+    var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+    let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &bsdf_rng);
+    var throughput = (*path).throughput * s.weight;
+    if all(throughput == vec3<f32>(0.0)) {
+        return true;
+    }
+    if bounce >= params.roulette_start {
+        // Russian roulette: continue with probability q and divide by it, so the estimate
+        // stays unbiased while dim paths end early.
+        var roulette_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed);
+        let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+        if rng_next(&roulette_rng) >= q {
+            return true;
+        }
+        throughput /= q;
+    }
+    (*path).throughput = throughput;
+    (*path).came_from_delta = s.is_delta;
+    (*path).bsdf_pdf_of_ray = s.pdf;
+    // Leave on the side the new direction goes to.
+    let side = select(-hit.normal, hit.normal, dot(s.dir, hit.normal) >= 0.0);
+    (*path).ray = Ray(offset_ray_origin(p, side), s.dir);
+    (*path).ray_start = p;
+    (*path).bounce = bounce + 1u;
+    return false;
+}
+
+// Radiance carried by one camera path through pixel (px, py).
+fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
+    var path = start_path(pixel, px, py, sample);
+    loop {
+        if path_step(&path, pixel, sample) {
             break;
         }
-        if bounce >= params.roulette_start {
-            // Russian roulette: continue with probability q and divide by it, so the estimate
-            // stays unbiased while dim paths end early.
-            var roulette_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed);
-            let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
-            if rng_next(&roulette_rng) >= q {
-                break;
-            }
-            throughput /= q;
-        }
-        came_from_delta = s.is_delta;
-        bsdf_pdf_of_ray = s.pdf;
-        // Leave on the side the new direction goes to.
-        let side = select(-hit.normal, hit.normal, dot(s.dir, hit.normal) >= 0.0);
-        ray = Ray(offset_ray_origin(p, side), s.dir);
-        ray_start = p;
     }
-    return radiance;
+    return path.radiance;
 }
 
 @compute @workgroup_size(8, 8, 1)
 fn render(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.width || id.y >= params.height {
+    if id.x >= params.width || id.y >= params.height || params.sample_count == 0u {
         return;
     }
     let pixel = id.y * params.width + id.x;
     // Welford over this batch's samples...
     var mean = vec3<f32>(0.0);
     var m2 = vec3<f32>(0.0);
-    for (var i = 0u; i < params.sample_count; i++) {
-        let x = trace_path(pixel, id.x, id.y, params.sample_start + i);
-        let delta = x - mean;
-        mean += delta / f32(i + 1u);
-        m2 += delta * (x - mean);
+    // Path regeneration: one loop over segments, and a lane whose path ends starts its next
+    // sample at once, instead of idling until the longest path among its SIMD neighbours
+    // ends. Each sample's result is the same as trace_path's (the random numbers depend on
+    // the sample, not on the schedule), and samples finish in order.
+    var done = 0u;
+    var path = start_path(pixel, id.x, id.y, params.sample_start);
+    loop {
+        if path_step(&path, pixel, params.sample_start + done) {
+            let x = path.radiance;
+            let delta = x - mean;
+            mean += delta / f32(done + 1u);
+            m2 += delta * (x - mean);
+            done += 1u;
+            if done == params.sample_count {
+                break;
+            }
+            path = start_path(pixel, id.x, id.y, params.sample_start + done);
+        }
     }
     // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
     let n_old = f32(params.sample_start);

@@ -41,7 +41,7 @@ pub struct BenchCase {
 pub fn cases(quick: bool) -> Vec<BenchCase> {
     let mut out = Vec::new();
     for device in [BenchDevice::Gpu, BenchDevice::Cpu] {
-        for (size, spp, batch_spp) in [(256, 16, 4), (512, 4, 1)] {
+        for (size, spp, batch_spp) in [(256, 32, 8), (512, 8, 2)] {
             for light_sampling in [false, true] {
                 out.push(if quick {
                     BenchCase {

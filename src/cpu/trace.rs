@@ -18,8 +18,145 @@ pub struct SceneRefs<'a> {
     pub emitters: &'a [Emitter],
 }
 
-/// Radiance carried by one camera path through pixel (px, py); `segments` counts the ray
-/// segments traced (camera, bounce and shadow rays), as the kernel's counter does.
+/// A path in flight: what one more segment needs.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState {
+    pub ray: Ray,
+    pub throughput: Vec3,
+    pub radiance: Vec3,
+    /// The surface point the current ray left from (light pdfs are evaluated there).
+    pub ray_start: Vec3,
+    /// How the current ray was sampled, for weighting the emitter it may hit.
+    pub bsdf_pdf_of_ray: f32,
+    pub bounce: u32,
+    pub came_from_delta: bool,
+}
+
+pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
+    let mut camera_rng = Rng::new(pixel, sample, 0, params.seed);
+    let jitter = (camera_rng.next_f32(), camera_rng.next_f32());
+    let lens = (camera_rng.next_f32(), camera_rng.next_f32());
+    let ray = camera_ray(params, px, py, jitter, lens);
+    PathState {
+        ray,
+        throughput: Vec3::ONE,
+        radiance: Vec3::ZERO,
+        ray_start: ray.origin,
+        bsdf_pdf_of_ray: 0.0,
+        bounce: 0,
+        came_from_delta: true,
+    }
+}
+
+/// Traces one segment of the path (and its shadow ray); true when the path has ended.
+/// `segments` counts the ray segments traced, as the kernel's counter does.
+pub fn path_step(
+    scene: &SceneRefs,
+    path: &mut PathState,
+    pixel: u32,
+    sample: u32,
+    segments: &mut u32,
+) -> bool {
+    let params = scene.params;
+    let ray = path.ray;
+    let bounce = path.bounce;
+    let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
+    let hit = intersect_scene(scene.spheres, scene.quads, &ray);
+    *segments += 1;
+    if hit.t == NO_HIT {
+        path.radiance += path.throughput * Vec3::from(params.background);
+        return true;
+    }
+    let m = &scene.materials[hit.material as usize];
+    let emission = Vec3::from(m.emission);
+    if emission.cmpgt(Vec3::ZERO).any() {
+        // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
+        // from the previous vertex; camera rays and delta bounces count in full.
+        let mut weight = 1.0;
+        if light_sampling && !path.came_from_delta {
+            let pdf = light_pdf(
+                scene,
+                path.ray_start,
+                ray.origin,
+                ray.dir,
+                hit.primitive,
+                hit.index,
+            );
+            weight = power_heuristic(path.bsdf_pdf_of_ray, pdf);
+        }
+        path.radiance += path.throughput * emission * weight;
+    }
+    // max_bounces counts scattering events; this also bounds every path's length.
+    if bounce >= params.max_bounces {
+        return true;
+    }
+    let p = hit.position;
+    let wo = -ray.dir;
+    let origin = offset_ray_origin(p, hit.normal);
+    if light_sampling && !is_delta(m) {
+        // Next-event estimation: light arriving after one more scattering event.
+        let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
+        let light = sample_light(scene, p, origin, &mut light_rng);
+        if light.pdf > 0.0 {
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
+            if f_cos.cmpgt(Vec3::ZERO).any() {
+                let shadow = Ray {
+                    origin,
+                    dir: light.dir,
+                };
+                let blocker = intersect_scene(scene.spheres, scene.quads, &shadow);
+                *segments += 1;
+                if blocker.t != NO_HIT
+                    && blocker.primitive == light.primitive
+                    && blocker.index == light.index
+                {
+                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                    path.radiance +=
+                        path.throughput * f_cos * light.radiance * (weight / light.pdf);
+                }
+            }
+        }
+    }
+    let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+    let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &mut bsdf_rng);
+    let mut throughput = path.throughput * s.weight;
+    if throughput == Vec3::ZERO {
+        return true;
+    }
+    if bounce >= params.roulette_start {
+        // Russian roulette: continue with probability q and divide by it, so the estimate
+        // stays unbiased while dim paths end early.
+        let mut roulette_rng = Rng::new(
+            pixel,
+            sample,
+            stream_id(bounce, PURPOSE_ROULETTE),
+            params.seed,
+        );
+        let q = throughput.x.max(throughput.y.max(throughput.z)).min(0.95);
+        if roulette_rng.next_f32() >= q {
+            return true;
+        }
+        throughput /= q;
+    }
+    path.throughput = throughput;
+    path.came_from_delta = s.is_delta;
+    path.bsdf_pdf_of_ray = s.pdf;
+    // Leave on the side the new direction goes to.
+    let side = if s.dir.dot(hit.normal) >= 0.0 {
+        hit.normal
+    } else {
+        -hit.normal
+    };
+    path.ray = Ray {
+        origin: offset_ray_origin(p, side),
+        dir: s.dir,
+    };
+    path.ray_start = p;
+    path.bounce = bounce + 1;
+    false
+}
+
+/// Radiance carried by one camera path through pixel (px, py).
 pub fn trace_path(
     scene: &SceneRefs,
     pixel: u32,
@@ -28,117 +165,9 @@ pub fn trace_path(
     sample: u32,
     segments: &mut u32,
 ) -> Vec3 {
-    let params = scene.params;
-    let mut camera_rng = Rng::new(pixel, sample, 0, params.seed);
-    let jitter = (camera_rng.next_f32(), camera_rng.next_f32());
-    let lens = (camera_rng.next_f32(), camera_rng.next_f32());
-    let mut ray = camera_ray(params, px, py, jitter, lens);
-    let mut throughput = Vec3::ONE;
-    let mut radiance = Vec3::ZERO;
-    // How the current ray was sampled, for weighting the emitter it may hit.
-    let mut came_from_delta = true;
-    let mut bsdf_pdf_of_ray = 0.0;
-    // The surface point the current ray left from (light pdfs are evaluated there).
-    let mut ray_start = ray.origin;
-    let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
-    let background = Vec3::from(params.background);
-    // max_bounces counts scattering events.
-    for bounce in 0..=params.max_bounces {
-        let hit = intersect_scene(scene.spheres, scene.quads, &ray);
-        *segments += 1;
-        if hit.t == NO_HIT {
-            radiance += throughput * background;
-            break;
-        }
-        let m = &scene.materials[hit.material as usize];
-        let emission = Vec3::from(m.emission);
-        if emission.cmpgt(Vec3::ZERO).any() {
-            // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
-            // from the previous vertex; camera rays and delta bounces count in full.
-            let mut weight = 1.0;
-            if light_sampling && !came_from_delta {
-                let pdf = light_pdf(
-                    scene,
-                    ray_start,
-                    ray.origin,
-                    ray.dir,
-                    hit.primitive,
-                    hit.index,
-                );
-                weight = power_heuristic(bsdf_pdf_of_ray, pdf);
-            }
-            radiance += throughput * emission * weight;
-        }
-        if bounce == params.max_bounces {
-            break;
-        }
-        let p = hit.position;
-        let wo = -ray.dir;
-        let origin = offset_ray_origin(p, hit.normal);
-        if light_sampling && !is_delta(m) {
-            // Next-event estimation: light arriving after one more scattering event.
-            let mut light_rng =
-                Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
-            let light = sample_light(scene, p, origin, &mut light_rng);
-            if light.pdf > 0.0 {
-                let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
-                if f_cos.cmpgt(Vec3::ZERO).any() {
-                    let blocker = intersect_scene(
-                        scene.spheres,
-                        scene.quads,
-                        &Ray {
-                            origin,
-                            dir: light.dir,
-                        },
-                    );
-                    *segments += 1;
-                    if blocker.t != NO_HIT
-                        && blocker.primitive == light.primitive
-                        && blocker.index == light.index
-                    {
-                        let weight =
-                            power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
-                        radiance += throughput * f_cos * light.radiance * (weight / light.pdf);
-                    }
-                }
-            }
-        }
-        let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
-        let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &mut bsdf_rng);
-        throughput *= s.weight;
-        if throughput == Vec3::ZERO {
-            break;
-        }
-        if bounce >= params.roulette_start {
-            // Russian roulette: continue with probability q and divide by it, so the estimate
-            // stays unbiased while dim paths end early.
-            let mut roulette_rng = Rng::new(
-                pixel,
-                sample,
-                stream_id(bounce, PURPOSE_ROULETTE),
-                params.seed,
-            );
-            let q = throughput.x.max(throughput.y.max(throughput.z)).min(0.95);
-            if roulette_rng.next_f32() >= q {
-                break;
-            }
-            throughput /= q;
-        }
-        came_from_delta = s.is_delta;
-        bsdf_pdf_of_ray = s.pdf;
-        // Leave on the side the new direction goes to.
-        let side = if s.dir.dot(hit.normal) >= 0.0 {
-            hit.normal
-        } else {
-            -hit.normal
-        };
-        ray = Ray {
-            origin: offset_ray_origin(p, side),
-            dir: s.dir,
-        };
-        ray_start = p;
-    }
-    radiance
+    let mut path = start_path(scene.params, pixel, px, py, sample);
+    while !path_step(scene, &mut path, pixel, sample, segments) {}
+    path.radiance
 }
 
 /// Running per-pixel statistics: the mean radiance and M2, the sum of squared deviations.
@@ -150,7 +179,8 @@ pub struct PixelStats {
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
 /// `params.sample_start`, merged into `stats`, which holds the `params.sample_start` samples
-/// before them. Returns the ray segments traced.
+/// before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
+/// for SIMD efficiency; each sample's result is the same, and they finish in the same order.)
 pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
     let params = scene.params;
     let pixel = py * params.width + px;
