@@ -485,3 +485,46 @@ fn compare_reports_metrics_z_tests_and_writes_a_difference_image() {
         );
     }
 }
+
+/// `glint bench --quick` runs every configuration and reports its figures. The GPU and the CPU
+/// trace the same paths for the same seed, so their segment counts per path agree closely:
+/// that checks the kernel's ray counter against the CPU mirror's.
+#[test]
+fn bench_runs_and_its_ray_counts_agree_between_devices() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let summary = json(&glint(
+        dir.path(),
+        &["bench", "--quick", "--runs", "1", "--json"],
+    ));
+    let results = summary["results"].as_array().unwrap();
+    assert_eq!(
+        results.len(),
+        8,
+        "2 devices × 2 sizes × light sampling on/off"
+    );
+    assert_eq!(summary["gpu_backend"], "vulkan");
+    for r in results {
+        assert!(r["paths_per_second"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(r["ms_per_batch"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(r["rays_per_second"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    let per_path = |device: &str, size: u64, light: bool| {
+        results
+            .iter()
+            .find(|r| r["device"] == device && r["width"] == size && r["light_sampling"] == light)
+            .and_then(|r| r["segments_per_path"].as_f64())
+            .unwrap()
+    };
+    for (size, light) in [(32, false), (32, true), (64, false), (64, true)] {
+        let (gpu, cpu) = (per_path("gpu", size, light), per_path("cpu", size, light));
+        assert!(
+            (gpu / cpu - 1.0).abs() < 0.02,
+            "{size}² light {light}: gpu {gpu} vs cpu {cpu}"
+        );
+        // Shadow rays: more segments with light sampling.
+        assert!(cpu > if light { 4.0 } else { 2.0 }, "{cpu}");
+    }
+}
