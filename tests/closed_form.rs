@@ -183,38 +183,7 @@ fn zero_bounces_sees_only_emitters() {
 /// 0.05 units of the point below the sphere, where E varies by < 0.1%.
 #[test]
 fn floor_under_an_emitting_sphere_matches_the_irradiance_formula() {
-    let scene = kernel_scene(
-        r#"
-[camera]
-eye = [0.0, 5.0, -8.660254]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 0.5
-[render]
-width = 48
-height = 48
-spp = 64
-max_bounces = 1
-seed = 11
-[materials.floor]
-type = "diffuse"
-color = [0.6, 0.6, 0.6]
-[materials.lamp]
-type = "diffuse"
-color = [0.0, 0.0, 0.0]
-emission = [1.0, 1.0, 1.0]
-strength = 4.0
-[[quads]]
-corner = [-100.0, 0.0, -100.0]
-u = [200.0, 0.0, 0.0]
-v = [0.0, 0.0, 200.0]
-material = "floor"
-[[spheres]]
-center = [0.0, 2.0, 0.0]
-radius = 1.0
-material = "lamp"
-"#,
-    );
+    let scene = common::floor_under_lamp(48, 64, 11);
     let (rho, l, p) = (0.6f64, 4.0f64, 0.25f64);
     let expected = rho * l * p;
     let n = 48.0 * 48.0 * 64.0;

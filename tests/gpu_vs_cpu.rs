@@ -1,8 +1,7 @@
 //! The GPU kernel and the CPU reference trace the same paths for the same seed.
 
 mod common;
-use common::{cornell, gpu, render_cpu, render_gpu};
-use glint::scene::RenderOverrides;
+use common::{gpu, render_cpu, render_gpu};
 
 /// Cornell box at 64×64, 1 sample per pixel, four seeds: each pixel is one path, so comparing
 /// pixels compares paths (with light sampling nearly every path carries light). Both sides use
@@ -18,15 +17,7 @@ fn gpu_and_cpu_trace_the_same_paths() {
     let (mut agree, mut lit, mut total) = (0usize, 0usize, 0usize);
     let mut worst_agreeing = 0.0f32;
     for seed in [3, 4, 5, 6] {
-        let scene = cornell()
-            .with_overrides(&RenderOverrides {
-                width: Some(64),
-                height: Some(64),
-                seed: Some(seed),
-                ..Default::default()
-            })
-            .unwrap()
-            .kernel_scene();
+        let scene = common::cornell_at(64, seed);
         let cpu = render_cpu(&scene, 1);
         let gpu = render_gpu(ctx, &scene, 1);
         for (a, b) in cpu.pixels.iter().zip(&gpu.pixels) {

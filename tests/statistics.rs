@@ -15,7 +15,7 @@
 //!   on the 64² Cornell box this detects a 3% bias.
 
 mod common;
-use common::{cornell, gpu};
+use common::gpu;
 use glint::compare::{compare, ZTest};
 use glint::cpu::renderer::CpuRenderer;
 use glint::gpu::GpuRenderer;
@@ -28,15 +28,7 @@ const MIN_PASS_RATE: f64 = 0.97;
 const MAX_Z_OF_MEANS: f64 = 4.0;
 
 fn cornell_64(seed: u32) -> KernelScene {
-    cornell()
-        .with_overrides(&RenderOverrides {
-            width: Some(64),
-            height: Some(64),
-            seed: Some(seed),
-            ..Default::default()
-        })
-        .unwrap()
-        .kernel_scene()
+    common::cornell_at(64, seed)
 }
 
 /// Mean and variance images after `spp` samples.
@@ -193,38 +185,7 @@ fn variance_ratio(a: &(Image, Image), b: &(Image, Image)) -> (f64, f64) {
 #[test]
 fn target_error_stops_with_the_real_error_near_the_target() {
     let Some(ctx) = gpu() else { return };
-    let scene = common::kernel_scene(
-        r#"
-[camera]
-eye = [0.0, 5.0, -8.660254]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 0.5
-[render]
-width = 16
-height = 16
-spp = 100000
-max_bounces = 1
-seed = 5
-[materials.floor]
-type = "diffuse"
-color = [0.6, 0.6, 0.6]
-[materials.lamp]
-type = "diffuse"
-color = [0.0, 0.0, 0.0]
-emission = [1.0, 1.0, 1.0]
-strength = 4.0
-[[quads]]
-corner = [-100.0, 0.0, -100.0]
-u = [200.0, 0.0, 0.0]
-v = [0.0, 0.0, 200.0]
-material = "floor"
-[[spheres]]
-center = [0.0, 2.0, 0.0]
-radius = 1.0
-material = "lamp"
-"#,
-    );
+    let scene = common::floor_under_lamp(16, 100_000, 5);
     let target = 0.02;
     let mut renderer = GpuRenderer::new(ctx, &scene).unwrap();
     let stats = glint::render::render_progressive(

@@ -87,6 +87,32 @@ impl GpuContext {
         format!("{:?}", self.adapter_info.backend).to_lowercase()
     }
 
+    /// Maps a MAP_READ buffer (after the copies into it were submitted), waits for the GPU, and
+    /// hands its bytes to `read`.
+    pub fn read_mapped<T>(
+        &self,
+        buffer: &wgpu::Buffer,
+        read: impl FnOnce(&[u8]) -> T,
+    ) -> anyhow::Result<T> {
+        let slice = buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.wait_idle()?;
+        rx.recv()
+            .map_err(|_| anyhow::anyhow!("GPU readback was dropped"))?
+            .map_err(|e| anyhow::anyhow!("GPU readback failed: {e}"))?;
+        let value = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| anyhow::anyhow!("GPU readback failed: {e}"))?;
+            read(&view)
+        };
+        buffer.unmap();
+        Ok(value)
+    }
+
     /// Blocks until all submitted work is done.
     pub fn wait_idle(&self) -> anyhow::Result<()> {
         self.device

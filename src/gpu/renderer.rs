@@ -40,7 +40,11 @@ struct Instruments {
 
 /// A read-only storage buffer holding `items`; bindings cannot be empty, so an empty list
 /// uploads one zeroed element (the kernel reads the real count from `Params`).
-fn storage_buffer<T: Pod + Default>(ctx: &GpuContext, label: &str, items: &[T]) -> wgpu::Buffer {
+pub fn storage_buffer<T: Pod + Default>(
+    ctx: &GpuContext,
+    label: &str,
+    items: &[T],
+) -> wgpu::Buffer {
     let placeholder = [T::default()];
     let items = if items.is_empty() {
         &placeholder[..]
@@ -201,24 +205,11 @@ impl<'a> GpuRenderer<'a> {
         }
         encoder.clear_buffer(&self.counter_buffer, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
-        let slice = instruments.readback.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.ctx.wait_idle()?;
-        rx.recv()
-            .map_err(|_| anyhow!("GPU readback was dropped"))?
-            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-        let (segments, t0, t1) = {
-            let view = slice
-                .get_mapped_range()
-                .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-            let words: &[u32] = bytemuck::cast_slice(&view[..8]);
-            let stamps: &[u64] = bytemuck::cast_slice(&view[8..24]);
+        let (segments, t0, t1) = self.ctx.read_mapped(&instruments.readback, |bytes| {
+            let words: &[u32] = bytemuck::cast_slice(&bytes[..8]);
+            let stamps: &[u64] = bytemuck::cast_slice(&bytes[8..24]);
             (words[0], stamps[0], stamps[1])
-        };
-        instruments.readback.unmap();
+        })?;
         instruments.segments += segments as u64;
         if instruments.timestamps.is_some() && t1 > t0 {
             let ns = (t1 - t0) as f64 * self.ctx.queue.get_timestamp_period() as f64;
@@ -256,26 +247,12 @@ impl<'a> GpuRenderer<'a> {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         encoder.copy_buffer_to_buffer(buffer, 0, &self.readback_buffer, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
-        let slice = self.readback_buffer.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.ctx.wait_idle()?;
-        rx.recv()
-            .map_err(|_| anyhow!("GPU readback was dropped"))?
-            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-        let values = {
-            let view = slice
-                .get_mapped_range()
-                .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-            bytemuck::cast_slice::<u8, [f32; 4]>(&view)
+        self.ctx.read_mapped(&self.readback_buffer, |bytes| {
+            bytemuck::cast_slice::<u8, [f32; 4]>(bytes)
                 .iter()
                 .map(|p| [p[0], p[1], p[2]])
                 .collect()
-        };
-        self.readback_buffer.unmap();
-        Ok(values)
+        })
     }
 
     fn image(&self, pixels: Vec<[f32; 3]>) -> Image {

@@ -62,3 +62,54 @@ pub fn render_both(scene: &KernelScene, spp: u32) -> Vec<(&'static str, Image)> 
 pub fn cornell() -> Scene {
     Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml")).unwrap()
 }
+
+/// The Cornell box at `size`², with `seed`.
+pub fn cornell_at(size: u32, seed: u32) -> KernelScene {
+    cornell()
+        .with_overrides(&glint::scene::RenderOverrides {
+            width: Some(size),
+            height: Some(size),
+            seed: Some(seed),
+            ..Default::default()
+        })
+        .unwrap()
+        .kernel_scene()
+}
+
+/// A diffuse floor of albedo 0.6 under an emitting sphere (radiance 4, radius 1, centre 2 above
+/// the origin), seen at 30° elevation through a 0.5° lens, with one bounce: every pixel sees the
+/// point below the lamp, whose radiance is ρ L (r/d)² = 0.6 (tests/closed_form.rs derives it).
+pub fn floor_under_lamp(size: u32, spp: u32, seed: u32) -> KernelScene {
+    kernel_scene(&format!(
+        r#"
+[camera]
+eye = [0.0, 5.0, -8.660254]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 0.5
+[render]
+width = {size}
+height = {size}
+spp = {spp}
+max_bounces = 1
+seed = {seed}
+[materials.floor]
+type = "diffuse"
+color = [0.6, 0.6, 0.6]
+[materials.lamp]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+strength = 4.0
+[[quads]]
+corner = [-100.0, 0.0, -100.0]
+u = [200.0, 0.0, 0.0]
+v = [0.0, 0.0, 200.0]
+material = "floor"
+[[spheres]]
+center = [0.0, 2.0, 0.0]
+radius = 1.0
+material = "lamp"
+"#
+    ))
+}

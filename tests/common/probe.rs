@@ -1,6 +1,7 @@
 //! Runs the WGSL sampling routines on the GPU through tests/shaders/probe.wgsl.
 
 use bytemuck::{Pod, Zeroable};
+use glint::gpu::renderer::storage_buffer;
 use glint::gpu::GpuContext;
 use glint::scene::KernelScene;
 use glint::shader::render_kernel_source;
@@ -26,21 +27,6 @@ pub const PROBE_SOURCE: &str = include_str!("../shaders/probe.wgsl");
 
 pub fn probe_module_source() -> String {
     render_kernel_source() + PROBE_SOURCE
-}
-
-fn storage<T: Pod + Default>(ctx: &GpuContext, items: &[T]) -> wgpu::Buffer {
-    let placeholder = [T::default()];
-    let items = if items.is_empty() {
-        &placeholder[..]
-    } else {
-        items
-    };
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: None,
-            contents: bytemuck::cast_slice(items),
-            usage: wgpu::BufferUsages::STORAGE,
-        })
 }
 
 fn layout_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
@@ -105,10 +91,10 @@ pub fn run_probe(
     };
     let scene_params = uniform(bytemuck::bytes_of(&scene.params));
     let probe_params = uniform(bytemuck::bytes_of(&params));
-    let spheres = storage(ctx, &scene.spheres);
-    let quads = storage(ctx, &scene.quads);
-    let materials = storage(ctx, &scene.materials);
-    let emitters = storage(ctx, &scene.emitters);
+    let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
+    let quads = storage_buffer(ctx, "quads", &scene.quads);
+    let materials = storage_buffer(ctx, "materials", &scene.materials);
+    let emitters = storage_buffer(ctx, "emitters", &scene.emitters);
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -148,13 +134,8 @@ pub fn run_probe(
     }
     encoder.copy_buffer_to_buffer(&out, 0, &readback, 0, None);
     ctx.queue.submit([encoder.finish()]);
-    readback
-        .slice(..)
-        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    ctx.wait_idle().unwrap();
-    let values =
-        bytemuck::cast_slice::<u8, [f32; 4]>(&readback.slice(..).get_mapped_range().unwrap())
-            .to_vec();
-    readback.unmap();
-    values
+    ctx.read_mapped(&readback, |bytes| {
+        bytemuck::cast_slice::<u8, [f32; 4]>(bytes).to_vec()
+    })
+    .unwrap()
 }
