@@ -11,6 +11,8 @@ pub struct GpuUnavailable(pub String);
 pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
+    /// The adapter the device was opened on (a window asks it for surface capabilities).
+    pub adapter: wgpu::Adapter,
     pub adapter_info: wgpu::AdapterInfo,
     pub features: wgpu::Features,
     errors: Arc<Mutex<Vec<String>>>,
@@ -64,6 +66,7 @@ impl GpuContext {
         Ok(GpuContext {
             device,
             queue,
+            adapter,
             adapter_info,
             features,
             errors,

@@ -191,22 +191,7 @@ impl App {
         // The renderer borrows the context for its whole life, and the viewer keeps both until
         // the process ends: leaking the context is the simple way to own both in one struct.
         let ctx: &'static GpuContext = Box::leak(Box::new(ctx));
-        // GpuContext keeps its adapter to itself. The same request returns the same adapter,
-        // whose capabilities for this surface pick the format and present mode.
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            compatible_surface: Some(&surface),
-            ..Default::default()
-        }))
-        .map_err(|e| anyhow!("no Vulkan device for the window ({e})"))?;
-        if adapter.get_info() != ctx.adapter_info {
-            return Err(anyhow!(
-                "the window's adapter {} is not the renderer's {}",
-                adapter.get_info().name,
-                ctx.adapter_info.name
-            ));
-        }
-        let caps = surface.get_capabilities(&adapter);
+        let caps = surface.get_capabilities(&ctx.adapter);
         let format = pick_format(&caps.formats)
             .ok_or_else(|| anyhow!("{} cannot present to this window", ctx.device_name()))?;
         // Mailbox shows the newest frame without tearing and never blocks the sampling;
