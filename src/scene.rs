@@ -79,6 +79,27 @@ pub struct Camera {
     pub focus_distance: f32,
 }
 
+/// The camera's orthonormal basis, right-handed: `w` points from the target back at the eye,
+/// image-right is `up × w`, image-up is `w × right`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraBasis {
+    pub w: Vec3,
+    pub right: Vec3,
+    pub image_up: Vec3,
+}
+
+impl Camera {
+    pub fn basis(&self) -> CameraBasis {
+        let w = (self.eye - self.target).normalize();
+        let right = self.up.cross(w).normalize();
+        CameraBasis {
+            w,
+            right,
+            image_up: w.cross(right),
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub width: u32,
@@ -230,10 +251,11 @@ impl Scene {
     pub fn kernel_scene(&self) -> KernelScene {
         let c = &self.camera;
         let r = &self.render;
-        // Right-handed: w points back at the eye, image-right is up × w.
-        let w = (c.eye - c.target).normalize();
-        let u = c.up.cross(w).normalize();
-        let v = w.cross(u);
+        let CameraBasis {
+            w,
+            right: u,
+            image_up: v,
+        } = c.basis();
         let half_height = (c.vfov.to_radians() * 0.5).tan();
         let half_width = half_height * r.width as f32 / r.height as f32;
         let lens_radius = 0.5 * c.aperture;

@@ -6,7 +6,7 @@
 //! direction never becomes parallel to `up` (the camera basis would be undefined there).
 
 use crate::scene::Camera;
-use glam::{Quat, Vec3};
+use glam::Quat;
 
 /// Orbit angle per pixel of drag, in radians: a drag across a 512-pixel window turns ~147°.
 pub const ORBIT_RADIANS_PER_PIXEL: f32 = 0.005;
@@ -17,24 +17,6 @@ pub const DOLLY_FACTOR_PER_STEP: f32 = 0.85;
 const MIN_DISTANCE: f32 = 1e-4;
 /// Smallest angle between the view direction and ±up, in radians (1°).
 const POLE_MARGIN: f32 = 0.017_453_3;
-
-/// The camera's orthonormal basis as the kernel builds it (`Scene::kernel_scene`):
-/// `w` points from the target back at the eye, image-right is `up × w`, image-up `w × right`.
-struct Basis {
-    w: Vec3,
-    right: Vec3,
-    image_up: Vec3,
-}
-
-fn basis(cam: &Camera) -> Basis {
-    let w = (cam.eye - cam.target).normalize();
-    let right = cam.up.cross(w).normalize();
-    Basis {
-        w,
-        right,
-        image_up: w.cross(right),
-    }
-}
 
 fn distance(cam: &Camera) -> f32 {
     (cam.eye - cam.target).length()
@@ -53,7 +35,7 @@ pub fn orbit(cam: &Camera, dx: f32, dy: f32) -> Camera {
     let theta = (theta - dy * ORBIT_RADIANS_PER_PIXEL)
         .clamp(POLE_MARGIN, std::f32::consts::PI - POLE_MARGIN);
     let yaw = Quat::from_axis_angle(up, -dx * ORBIT_RADIANS_PER_PIXEL);
-    let heading = yaw * horizontal.normalize_or(basis(cam).right.cross(up));
+    let heading = yaw * horizontal.normalize_or(cam.basis().right.cross(up));
     let eye = cam.target + dist * (theta.cos() * up + theta.sin() * heading);
     Camera { eye, ..cam.clone() }
 }
@@ -61,7 +43,7 @@ pub fn orbit(cam: &Camera, dx: f32, dy: f32) -> Camera {
 /// Slides eye and target in the image plane so the point at the target's depth follows the
 /// cursor; `viewport_height` is the window height in pixels.
 pub fn pan(cam: &Camera, dx: f32, dy: f32, viewport_height: u32) -> Camera {
-    let b = basis(cam);
+    let b = cam.basis();
     let world_per_pixel =
         2.0 * distance(cam) * (cam.vfov.to_radians() * 0.5).tan() / viewport_height.max(1) as f32;
     let delta = (-dx * b.right + dy * b.image_up) * world_per_pixel;
@@ -75,7 +57,7 @@ pub fn pan(cam: &Camera, dx: f32, dy: f32, viewport_height: u32) -> Camera {
 /// Moves the eye towards the target (`steps` > 0, wheel up) or away from it; it never reaches
 /// or passes the target.
 pub fn dolly(cam: &Camera, steps: f32) -> Camera {
-    let b = basis(cam);
+    let b = cam.basis();
     let dist = (distance(cam) * DOLLY_FACTOR_PER_STEP.powf(steps)).max(MIN_DISTANCE);
     Camera {
         eye: cam.target + dist * b.w,
@@ -86,7 +68,7 @@ pub fn dolly(cam: &Camera, steps: f32) -> Camera {
 /// Translates eye and target together along image-right, `up` and the view direction, in
 /// units of the eye–target distance, so the fly speed scales with the scene.
 pub fn fly(cam: &Camera, right: f32, up: f32, forward: f32) -> Camera {
-    let b = basis(cam);
+    let b = cam.basis();
     let delta = distance(cam) * (right * b.right + up * cam.up.normalize() - forward * b.w);
     Camera {
         eye: cam.eye + delta,
@@ -98,6 +80,7 @@ pub fn fly(cam: &Camera, right: f32, up: f32, forward: f32) -> Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     fn cornell() -> Camera {
         Camera {
@@ -126,7 +109,7 @@ mod tests {
     #[test]
     fn orbit_keeps_target_and_distance_and_turns_with_the_cursor() {
         let c = cornell();
-        let b = basis(&c);
+        let b = c.basis();
         let right = orbit(&c, 40.0, 0.0);
         assert_eq!(right.target, c.target);
         assert!((distance(&right) - distance(&c)).abs() < 1e-2);
@@ -152,7 +135,7 @@ mod tests {
             assert!(w.dot(Vec3::Y).abs() < POLE_MARGIN.cos() + 1e-4);
             assert!(o.eye.is_finite());
             // The basis the kernel builds stays defined.
-            assert!(basis(&o).right.is_finite());
+            assert!(o.basis().right.is_finite());
             // And orbiting back from the pole works.
             assert!(orbit(&o, 5.0, -dy.signum() * 10.0).eye.is_finite());
         }
@@ -164,7 +147,7 @@ mod tests {
         let p = pan(&c, 10.0, 0.0, 512);
         assert_eq!(p.eye - c.eye, p.target - c.target);
         // The scene follows the cursor, so the camera goes the other way.
-        assert!((p.eye - c.eye).dot(basis(&c).right) < 0.0);
+        assert!((p.eye - c.eye).dot(c.basis().right) < 0.0);
         // A full-height drag moves the view by the visible height at the target's depth.
         let full = pan(&c, 0.0, 512.0, 512);
         let visible = 2.0 * 800.0 * (20f32).to_radians().tan();
@@ -181,7 +164,7 @@ mod tests {
         assert!(distance(&far) > 800.0);
         let very_close = dolly(&c, 1e4);
         assert!(distance(&very_close) > 0.0);
-        assert!(basis(&very_close).w.dot(basis(&c).w) > 0.999);
+        assert!(very_close.basis().w.dot(c.basis().w) > 0.999);
     }
 
     #[test]
@@ -193,6 +176,6 @@ mod tests {
         let up = fly(&c, 0.0, 0.25, 0.0);
         assert!(close(up.eye, c.eye + Vec3::new(0.0, 200.0, 0.0), 1e-2));
         let r = fly(&c, 0.1, 0.0, 0.0);
-        assert!(close(r.eye - c.eye, 80.0 * basis(&c).right, 1e-2));
+        assert!(close(r.eye - c.eye, 80.0 * c.basis().right, 1e-2));
     }
 }
