@@ -38,6 +38,22 @@ impl ImageFormat {
     }
 }
 
+/// A path an image can be written to: a known format, in a folder that exists. Checked before
+/// rendering, so a bad path fails at once instead of after the render.
+pub fn check_output_path(path: &Path) -> Result<(), String> {
+    ImageFormat::from_path(path)?;
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(format!(
+                "{}: the output folder {} does not exist",
+                path.display(),
+                dir.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The sRGB transfer function of a linear value in [0, 1].
 pub fn srgb_encode(linear: f32) -> f32 {
     if linear <= 0.0031308 {

@@ -1,9 +1,8 @@
 //! `glint compare`.
 
-use super::render::check_output_path;
 use crate::compare::{compare, difference_image, Z_CRITICAL, Z_TEST_ALPHA};
 use crate::error::InputError;
-use crate::output::Image;
+use crate::output::{check_output_path, Image};
 use anyhow::Result;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -35,7 +34,7 @@ fn read(path: &Path) -> Result<Image, InputError> {
 
 pub fn run(args: CompareArgs) -> Result<()> {
     if let Some(diff) = &args.diff {
-        check_output_path(diff)?;
+        check_output_path(diff).map_err(InputError)?;
     }
     let a = read(&args.a)?;
     let b = read(&args.b)?;

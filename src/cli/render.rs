@@ -3,7 +3,7 @@
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
-use crate::output::ImageFormat;
+use crate::output::{check_output_path, ImageFormat};
 use crate::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::{Context, Result};
@@ -114,21 +114,6 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
     }
 }
 
-/// A writable image path: a known format, in a folder that exists.
-pub(crate) fn check_output_path(output: &Path) -> Result<(), InputError> {
-    ImageFormat::from_path(output).map_err(InputError)?;
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(InputError(format!(
-                "{}: the output folder {} does not exist",
-                output.display(),
-                dir.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
 pub fn run(args: RenderArgs) -> Result<()> {
     let started = Instant::now();
     let scene = Scene::load(&args.scene).map_err(InputError::from)?;
@@ -147,9 +132,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.scene));
-    check_output_path(&output)?;
+    check_output_path(&output).map_err(InputError)?;
     if let Some(variance) = &args.variance {
-        check_output_path(variance)?;
+        check_output_path(variance).map_err(InputError)?;
         if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
             return Err(InputError(format!(
                 "{}: --variance needs an .exr file (linear floats)",

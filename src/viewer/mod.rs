@@ -14,7 +14,7 @@ pub mod input;
 pub mod watch;
 
 use crate::error::InputError;
-use crate::output::ImageFormat;
+use crate::output::check_output_path;
 use crate::scene::{RenderOverrides, Scene};
 use action::Script;
 use anyhow::Result;
@@ -65,17 +65,7 @@ pub fn run(options: ViewOptions) -> Result<()> {
         })
         .map_err(|m| InputError(format!("{}: {m}", options.scene.display())))?;
     if let Some(shot) = &options.screenshot {
-        ImageFormat::from_path(shot).map_err(InputError)?;
-        if let Some(dir) = shot.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if !dir.is_dir() {
-                return Err(InputError(format!(
-                    "{}: the screenshot folder {} does not exist",
-                    shot.display(),
-                    dir.display()
-                ))
-                .into());
-            }
-        }
+        check_output_path(shot).map_err(InputError)?;
     }
     if !display_available() {
         return Err(InputError(format!(
