@@ -259,7 +259,7 @@ impl Scene {
         let half_height = (c.vfov.to_radians() * 0.5).tan();
         let half_width = half_height * r.width as f32 / r.height as f32;
         let lens_radius = 0.5 * c.aperture;
-        let (emitters, light_probability) = self.emitter_table();
+        let (emitters, sphere_light_probability, quad_light_probability) = self.emitter_table();
         let params = Params {
             eye: c.eye.into(),
             width: r.width,
@@ -296,7 +296,7 @@ impl Scene {
                 center: s.center.into(),
                 radius: s.radius,
                 material: s.material,
-                light_probability: light_probability(PRIMITIVE_SPHERE, i),
+                light_probability: sphere_light_probability[i],
                 _pad: [0; 2],
             })
             .collect();
@@ -315,7 +315,7 @@ impl Scene {
                     edge_v: q.v.into(),
                     plane_offset: normal.dot(q.corner),
                     normal: normal.into(),
-                    light_probability: light_probability(PRIMITIVE_QUAD, i),
+                    light_probability: quad_light_probability[i],
                     u_dual: (q.u / q.u.dot(q.u)).into(),
                     v_dual: (q.v / q.v.dot(q.v)).into(),
                     ..Default::default()
@@ -354,9 +354,9 @@ impl Scene {
     }
 
     /// Every emitting primitive with its selection probability, proportional to its power
-    /// (mean emitted radiance × area; the factor π is common to all), and a lookup of that
-    /// probability by (primitive kind, index).
-    fn emitter_table(&self) -> (Vec<Emitter>, impl Fn(u32, usize) -> f32) {
+    /// (mean emitted radiance × area; the factor π is common to all), and that probability per
+    /// sphere and per quad (0 for those that do not emit).
+    fn emitter_table(&self) -> (Vec<Emitter>, Vec<f32>, Vec<f32>) {
         let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
         let mut powers: Vec<(u32, u32, f64)> = Vec::new();
         for (i, s) in self.spheres.iter().enumerate() {
@@ -392,14 +392,17 @@ impl Scene {
         if let Some(last) = emitters.last_mut() {
             last.cdf = 1.0;
         }
-        let lookup = emitters.clone();
-        let probability = move |primitive: u32, index: usize| {
-            lookup
-                .iter()
-                .find(|e| e.primitive == primitive && e.index == index as u32)
-                .map_or(0.0, |e| e.probability)
-        };
-        (emitters, probability)
+        let mut sphere_probability = vec![0.0; self.spheres.len()];
+        let mut quad_probability = vec![0.0; self.quads.len()];
+        for e in &emitters {
+            let per_primitive = if e.primitive == PRIMITIVE_SPHERE {
+                &mut sphere_probability
+            } else {
+                &mut quad_probability
+            };
+            per_primitive[e.index as usize] = e.probability;
+        }
+        (emitters, sphere_probability, quad_probability)
     }
 }
 
