@@ -66,7 +66,7 @@ fn intersect_scene(ray: Ray) -> Hit {
     var best_t = NO_HIT;
     var best_index = 0u;
     var best_is_sphere = false;
-    for (var i = 0u; i < params.sphere_count; i++) {
+    for (var i = 0u; i < sphere_count(); i++) {
         let t = hit_sphere(spheres[i], ray);
         if t < best_t {
             best_t = t;
@@ -74,7 +74,7 @@ fn intersect_scene(ray: Ray) -> Hit {
             best_is_sphere = true;
         }
     }
-    for (var i = 0u; i < params.quad_count; i++) {
+    for (var i = 0u; i < quad_count(); i++) {
         let t = hit_quad(quads[i], ray);
         if t < best_t {
             best_t = t;

@@ -14,12 +14,12 @@ struct LightSample {
 
 // Selection by the emitters' cumulative probabilities.
 fn pick_emitter(u: f32) -> u32 {
-    for (var i = 0u; i + 1u < params.emitter_count; i++) {
+    for (var i = 0u; i + 1u < emitter_count(); i++) {
         if u < emitters[i].cdf {
             return i;
         }
     }
-    return params.emitter_count - 1u;
+    return emitter_count() - 1u;
 }
 
 fn sphere_contains(s: Sphere, p: vec3<f32>) -> bool {
@@ -64,7 +64,7 @@ fn area_to_solid_angle(t: f32, cos_light: f32, area: f32) -> f32 {
 fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
-    if params.emitter_count == 0u {
+    if emitter_count() == 0u {
         return out;
     }
     let e = emitters[pick_emitter(rng_next(rng))];

@@ -93,15 +93,13 @@ struct Ray {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
-@group(0) @binding(2) var<storage, read> quads: array<Quad>;
-@group(0) @binding(3) var<storage, read> materials: array<Material>;
+// The scene's objects (bindings 1, 2, 3 and 6) are declared by scene_storage.wgsl or
+// scene_uniform.wgsl, whichever the host chose (src/shader.rs).
 // Per pixel, over all samples so far: the mean radiance (xyz; w unused) and M2, the sum of
 // squared deviations from the mean (xyz), from which the variance follows. Running means and
 // M2 stay accurate in f32 over millions of samples, where sums of squares would cancel.
 @group(0) @binding(4) var<storage, read_write> accum_mean: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> accum_m2: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> emitters: array<Emitter>;
 // Ray segments traced (camera, bounce and shadow rays), for benchmarks; wraps at 2^32, so the
 // host reads and clears it after each batch when it wants the figure.
 @group(0) @binding(7) var<storage, read_write> segments_traced: atomic<u32>;

@@ -4,6 +4,7 @@
 
 use crate::render::Renderer;
 use crate::scene::{KernelScene, RenderOverrides, Scene};
+use crate::shader::SceneBinding;
 use anyhow::Result;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -92,6 +93,17 @@ pub struct BenchResult {
     pub kernel_ms_per_batch: Option<f64>,
     /// Ray segments per path (camera, bounce and shadow rays).
     pub segments_per_path: Option<f64>,
+    /// The GPU kernel's scene binding (None on the CPU).
+    pub scene_binding: Option<SceneBinding>,
+}
+
+impl BenchResult {
+    pub fn with_scene_binding(self, binding: SceneBinding) -> BenchResult {
+        BenchResult {
+            scene_binding: Some(binding),
+            ..self
+        }
+    }
 }
 
 fn median(values: &mut [f64]) -> f64 {
@@ -140,5 +152,6 @@ pub fn run_case(renderer: &mut dyn Renderer, case: BenchCase, runs: usize) -> Re
         ms_per_batch: median(&mut batch_ms),
         kernel_ms_per_batch: (!kernel_ms.is_empty()).then(|| median(&mut kernel_ms)),
         segments_per_path: (!segments.is_empty()).then(|| median(&mut segments)),
+        scene_binding: None,
     })
 }

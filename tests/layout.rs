@@ -1,13 +1,19 @@
 //! The kernel is valid WGSL, and the Rust structs in src/shader_types.rs match the WGSL ones
 //! byte for byte (naga's layouter), so the host and the kernel cannot drift apart.
 
-use glint::shader::{render_kernel_source, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
+use glint::shader::{
+    render_kernel_source, render_kernel_source_for, SceneBinding, SceneCounts, RENDER_ENTRY_POINT,
+    WORKGROUP_SIZE,
+};
 use glint::shader_types::{Emitter, Material, Params, Quad, Sphere};
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
 
 fn parse_and_validate() -> naga::Module {
-    let source = render_kernel_source();
+    validate_source(render_kernel_source())
+}
+
+fn validate_source(source: String) -> naga::Module {
     let module = naga::front::wgsl::parse_str(&source)
         .unwrap_or_else(|e| panic!("{}", e.emit_to_string(&source)));
     naga::valid::Validator::new(
@@ -158,4 +164,69 @@ fn material_kind_constants_match() {
         constant("MATERIAL_SPECULAR"),
         glint::shader_types::MATERIAL_SPECULAR
     );
+}
+
+/// The uniform-buffer kernel validates for any counts, empty arrays included, and declares
+/// each array with exactly as many bytes as the host uploads (at least one element).
+#[test]
+fn uniform_scene_kernel_declares_the_uploaded_sizes() {
+    for counts in [
+        SceneCounts {
+            spheres: 0,
+            quads: 0,
+            materials: 1,
+            emitters: 0,
+        },
+        SceneCounts {
+            spheres: 2,
+            quads: 6,
+            materials: 5,
+            emitters: 1,
+        },
+        SceneCounts {
+            spheres: 1,
+            quads: 682,
+            materials: 3,
+            emitters: 2,
+        },
+    ] {
+        let module = validate_source(render_kernel_source_for(SceneBinding::Uniform(counts)));
+        let mut layouter = Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let binding_size = |binding: u32| {
+            let (_, var) = module
+                .global_variables
+                .iter()
+                .find(|(_, v)| v.binding.as_ref().is_some_and(|b| b.binding == binding))
+                .unwrap_or_else(|| panic!("no binding {binding}"));
+            assert_eq!(var.space, naga::AddressSpace::Uniform, "binding {binding}");
+            layouter[var.ty].size as usize
+        };
+        let uploaded = |count: u32, size: usize| count.max(1) as usize * size;
+        assert_eq!(
+            binding_size(1),
+            uploaded(counts.spheres, size_of::<Sphere>())
+        );
+        assert_eq!(binding_size(2), uploaded(counts.quads, size_of::<Quad>()));
+        assert_eq!(
+            binding_size(3),
+            uploaded(counts.materials, size_of::<Material>())
+        );
+        assert_eq!(
+            binding_size(6),
+            uploaded(counts.emitters, size_of::<Emitter>())
+        );
+        assert_eq!(
+            counts.largest_uniform_buffer() as usize,
+            [
+                binding_size(1),
+                binding_size(2),
+                binding_size(3),
+                binding_size(6)
+            ]
+            .into_iter()
+            .max()
+            .unwrap()
+        );
+    }
 }

@@ -3,8 +3,20 @@
 use crate::bench::{case_scene, cases, run_case, BenchDevice, BenchResult};
 use crate::cpu::renderer::CpuRenderer;
 use crate::gpu::{GpuContext, GpuRenderer};
+use crate::shader::{SceneBinding, SceneCounts};
 use anyhow::Result;
-use clap::Args;
+use clap::{Args, ValueEnum};
+
+/// Which scene binding the GPU kernel uses in the benchmark.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SceneBindingChoice {
+    /// What `render` uses: uniform buffers when the scene fits, storage buffers otherwise.
+    Auto,
+    /// Storage buffers (the general kernel).
+    Storage,
+    /// Uniform buffers sized for the scene.
+    Uniform,
+}
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -23,6 +35,9 @@ pub struct BenchArgs {
     /// Print the figures as JSON on stdout instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Where the GPU kernel reads the scene from, to compare the two kernels.
+    #[arg(long, value_enum, default_value_t = SceneBindingChoice::Auto)]
+    pub scene_binding: SceneBindingChoice,
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
@@ -45,9 +60,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let scene = case_scene(&case);
         let result = match (case.device, &gpu) {
             (BenchDevice::Gpu, Some(ctx)) => {
-                let mut renderer = GpuRenderer::new(ctx, &scene)?;
+                let binding = match args.scene_binding {
+                    SceneBindingChoice::Auto => SceneBinding::for_scene(
+                        &scene,
+                        ctx.device.limits().max_uniform_buffer_binding_size,
+                    ),
+                    SceneBindingChoice::Storage => SceneBinding::Storage,
+                    SceneBindingChoice::Uniform => SceneBinding::Uniform(SceneCounts::of(&scene)),
+                };
+                let mut renderer = GpuRenderer::with_scene_binding(ctx, &scene, binding)?;
                 renderer.instrument();
-                run_case(&mut renderer, case, args.runs as usize)?
+                run_case(&mut renderer, case, args.runs as usize)?.with_scene_binding(binding)
             }
             (BenchDevice::Cpu, _) if !args.gpu_only => {
                 run_case(&mut CpuRenderer::new(&scene), case, args.runs as usize)?
@@ -68,6 +91,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             .map(|r| {
                 serde_json::json!({
                     "device": r.case.device.as_str(),
+                    "scene_binding": r.scene_binding.map(|b| b.name()),
                     "width": r.case.size,
                     "height": r.case.size,
                     "max_bounces": 8,
@@ -98,7 +122,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
 
 fn header() -> String {
     format!(
-        "{:<6} {:>9} {:>6} {:>14} {:>14} {:>10} {:>10} {:>12}",
+        "{:<14} {:>9} {:>6} {:>14} {:>14} {:>10} {:>10} {:>12}",
         "device", "size", "light", "paths/s", "rays/s", "rays/path", "ms/batch", "kernel ms"
     )
 }
@@ -108,8 +132,11 @@ fn row(r: &BenchResult) -> String {
         v.map_or("-".to_string(), |v| format!("{:.*}", digits, v / scale))
     };
     format!(
-        "{:<6} {:>9} {:>6} {:>12.2} M {:>12} M {:>10} {:>10.1} {:>12}",
-        r.case.device.as_str(),
+        "{:<14} {:>9} {:>6} {:>12.2} M {:>12} M {:>10} {:>10.1} {:>12}",
+        match r.scene_binding {
+            Some(binding) => format!("{} ({})", r.case.device.as_str(), binding.name()),
+            None => r.case.device.as_str().to_string(),
+        },
         format!("{}²", r.case.size),
         if r.case.light_sampling { "on" } else { "off" },
         r.paths_per_second / 1e6,

@@ -4,7 +4,7 @@ use super::context::GpuContext;
 use crate::output::Image;
 use crate::render::{variance_of_mean, Renderer};
 use crate::scene::KernelScene;
-use crate::shader::{render_kernel_source, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
+use crate::shader::{render_kernel_source_for, SceneBinding, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
 use crate::shader_types::Params;
 use anyhow::{anyhow, Result};
 use bytemuck::Pod;
@@ -12,6 +12,7 @@ use wgpu::util::DeviceExt;
 
 pub struct GpuRenderer<'a> {
     ctx: &'a GpuContext,
+    scene_binding: SceneBinding,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     params: Params,
@@ -45,6 +46,17 @@ pub fn storage_buffer<T: Pod + Default>(
     label: &str,
     items: &[T],
 ) -> wgpu::Buffer {
+    scene_buffer(ctx, label, items, wgpu::BufferUsages::STORAGE)
+}
+
+/// A buffer of the scene's objects for a storage or uniform binding, holding at least one
+/// (zeroed) element, as the kernel's arrays do.
+fn scene_buffer<T: Pod + Default>(
+    ctx: &GpuContext,
+    label: &str,
+    items: &[T],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
     let placeholder = [T::default()];
     let items = if items.is_empty() {
         &placeholder[..]
@@ -55,16 +67,29 @@ pub fn storage_buffer<T: Pod + Default>(
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
             contents: bytemuck::cast_slice(items),
-            usage: wgpu::BufferUsages::STORAGE,
+            usage,
         })
 }
 
 impl<'a> GpuRenderer<'a> {
+    /// A renderer for `scene`, with its objects in uniform buffers when they fit the device's
+    /// limit and in storage buffers otherwise.
     pub fn new(ctx: &'a GpuContext, scene: &KernelScene) -> Result<GpuRenderer<'a>> {
+        let max_uniform = ctx.device.limits().max_uniform_buffer_binding_size;
+        Self::with_scene_binding(ctx, scene, SceneBinding::for_scene(scene, max_uniform))
+    }
+
+    /// A renderer with the scene bound as `scene_binding` says (tests and benchmarks compare
+    /// the two).
+    pub fn with_scene_binding(
+        ctx: &'a GpuContext,
+        scene: &KernelScene,
+        scene_binding: SceneBinding,
+    ) -> Result<GpuRenderer<'a>> {
         let device = &ctx.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("glint render kernel"),
-            source: wgpu::ShaderSource::Wgsl(render_kernel_source().into()),
+            source: wgpu::ShaderSource::Wgsl(render_kernel_source_for(scene_binding).into()),
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("glint render"),
@@ -92,10 +117,14 @@ impl<'a> GpuRenderer<'a> {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
-        let quads = storage_buffer(ctx, "quads", &scene.quads);
-        let materials = storage_buffer(ctx, "materials", &scene.materials);
-        let emitters = storage_buffer(ctx, "emitters", &scene.emitters);
+        let usage = match scene_binding {
+            SceneBinding::Storage => wgpu::BufferUsages::STORAGE,
+            SceneBinding::Uniform(_) => wgpu::BufferUsages::UNIFORM,
+        };
+        let spheres = scene_buffer(ctx, "spheres", &scene.spheres, usage);
+        let quads = scene_buffer(ctx, "quads", &scene.quads, usage);
+        let materials = scene_buffer(ctx, "materials", &scene.materials, usage);
+        let emitters = scene_buffer(ctx, "emitters", &scene.emitters, usage);
         let accumulator = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -143,6 +172,7 @@ impl<'a> GpuRenderer<'a> {
         ctx.wait_idle()?;
         Ok(GpuRenderer {
             ctx,
+            scene_binding,
             pipeline,
             bind_group,
             params,
@@ -222,6 +252,11 @@ impl<'a> GpuRenderer<'a> {
     /// on the GPU without a readback.
     pub fn mean_buffer(&self) -> &wgpu::Buffer {
         &self.mean_buffer
+    }
+
+    /// Where the kernel reads the scene from.
+    pub fn scene_binding(&self) -> SceneBinding {
+        self.scene_binding
     }
 
     /// The kernel parameters in use (camera, size, counts).

@@ -113,3 +113,48 @@ material = "lamp"
 "#
     ))
 }
+
+/// Pixel-by-pixel agreement of a CPU and a GPU render at 1 spp, where each pixel is one path
+/// (see tests/gpu_vs_cpu.rs for why a small fraction may differ).
+#[derive(Default)]
+pub struct PathAgreement {
+    agree: usize,
+    lit: usize,
+    total: usize,
+    worst_agreeing: f32,
+}
+
+impl PathAgreement {
+    /// Counts the paths whose radiance agrees to 1e-3 of its scale.
+    pub fn add(&mut self, cpu: &Image, gpu: &Image) {
+        assert_eq!(cpu.pixels.len(), gpu.pixels.len());
+        for (a, b) in cpu.pixels.iter().zip(&gpu.pixels) {
+            let diff = (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f32::max);
+            let scale = a.iter().chain(b).fold(1e-3f32, |m, v| m.max(v.abs()));
+            self.total += 1;
+            self.lit += a.iter().any(|v| *v > 0.0) as usize;
+            if diff <= 1e-3 * scale {
+                self.agree += 1;
+                self.worst_agreeing = self.worst_agreeing.max(diff / scale);
+            }
+        }
+    }
+
+    /// Asserts that at least `min_fraction` of the paths agree and that most carry light
+    /// (a black image would agree trivially).
+    pub fn check(&self, min_fraction: f64) {
+        let (agree, lit, total) = (self.agree, self.lit, self.total);
+        let fraction = agree as f64 / total as f64;
+        eprintln!(
+            "paths agreeing to 1e-3: {agree}/{total} ({:.2}%), worst relative difference among them {:.2e}; {lit} carry light",
+            100.0 * fraction,
+            self.worst_agreeing
+        );
+        assert!(lit > total * 3 / 4, "{lit} of {total} paths carry light");
+        assert!(
+            fraction >= min_fraction,
+            "only {:.2}% of paths agree",
+            100.0 * fraction
+        );
+    }
+}

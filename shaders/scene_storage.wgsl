@@ -1,0 +1,19 @@
+// The scene's objects in storage buffers: any number of them, with the counts in Params.
+// The general layout; scene_uniform.wgsl is the fast one for scenes that fit uniform buffers.
+
+@group(0) @binding(1) var<storage, read> spheres: array<Sphere>;
+@group(0) @binding(2) var<storage, read> quads: array<Quad>;
+@group(0) @binding(3) var<storage, read> materials: array<Material>;
+@group(0) @binding(6) var<storage, read> emitters: array<Emitter>;
+
+fn sphere_count() -> u32 {
+    return params.sphere_count;
+}
+
+fn quad_count() -> u32 {
+    return params.quad_count;
+}
+
+fn emitter_count() -> u32 {
+    return params.emitter_count;
+}

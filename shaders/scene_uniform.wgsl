@@ -1,0 +1,23 @@
+// The scene's objects in uniform buffers, sized for one scene: the host prepends the counts
+// (SPHERE_COUNT, QUAD_COUNT, MATERIAL_COUNT, EMITTER_COUNT) as constants, see src/shader.rs.
+// Why: every lane of a SIMD group tests the same primitive at the same time, and a uniform
+// buffer indexed by a constant loop counter lets the compiler load it once for all lanes (and
+// unroll the loops), where a storage buffer costs a gather per lane on lavapipe. Arrays hold at
+// least one element, since WGSL has no empty arrays.
+
+@group(0) @binding(1) var<uniform> spheres: array<Sphere, max(SPHERE_COUNT, 1u)>;
+@group(0) @binding(2) var<uniform> quads: array<Quad, max(QUAD_COUNT, 1u)>;
+@group(0) @binding(3) var<uniform> materials: array<Material, max(MATERIAL_COUNT, 1u)>;
+@group(0) @binding(6) var<uniform> emitters: array<Emitter, max(EMITTER_COUNT, 1u)>;
+
+fn sphere_count() -> u32 {
+    return SPHERE_COUNT;
+}
+
+fn quad_count() -> u32 {
+    return QUAD_COUNT;
+}
+
+fn emitter_count() -> u32 {
+    return EMITTER_COUNT;
+}

@@ -1,0 +1,120 @@
+//! The two scene bindings of the kernel (src/shader.rs): uniform buffers sized for the scene,
+//! the fast path, and storage buffers, for scenes too large for uniform buffers. Both must
+//! render what the CPU reference renders.
+
+mod common;
+use common::{gpu, kernel_scene, render_cpu};
+use glint::gpu::GpuRenderer;
+use glint::output::Image;
+use glint::render::render_image;
+use glint::scene::{KernelScene, RenderOverrides, Scene};
+use glint::shader::{SceneBinding, SceneCounts, MAX_UNIFORM_SCENE_BYTES};
+use std::path::Path;
+
+fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
+    let ctx = gpu().unwrap();
+    let mut renderer = GpuRenderer::with_scene_binding(ctx, scene, binding).unwrap();
+    assert_eq!(renderer.scene_binding(), binding);
+    render_image(&mut renderer, spp, spp).unwrap()
+}
+
+fn materials_scene(size: u32, seed: u32) -> KernelScene {
+    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-materials.toml"))
+        .unwrap()
+        .with_overrides(&RenderOverrides {
+            width: Some(size),
+            height: Some(size),
+            seed: Some(seed),
+            ..Default::default()
+        })
+        .unwrap()
+        .kernel_scene()
+}
+
+/// The same kernel code reads the same numbers from either binding, so every path is the same.
+#[test]
+fn uniform_and_storage_bindings_render_the_same_image() {
+    if gpu().is_none() {
+        return;
+    }
+    let scene = materials_scene(48, 7);
+    let uniform = render_with(&scene, SceneBinding::Uniform(SceneCounts::of(&scene)), 2);
+    let storage = render_with(&scene, SceneBinding::Storage, 2);
+    let differing = uniform
+        .pixels
+        .iter()
+        .zip(&storage.pixels)
+        .filter(|(a, b)| a != b)
+        .count();
+    eprintln!("{differing} of {} pixels differ", uniform.pixels.len());
+    assert_eq!(differing, 0);
+}
+
+/// The Cornell box with a grid of `tiles` small green quads in front of the back wall.
+fn tiled_cornell(tiles: u32, size: u32, seed: u32) -> KernelScene {
+    let mut toml =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml"))
+            .unwrap();
+    for i in 0..tiles {
+        let (x, y) = (10 + 19 * (i % 28), 10 + 19 * (i / 28));
+        toml += &format!(
+            "\n[[quads]]\ncorner = [{x}.0, {y}.0, 554.0]\nu = [12.0, 0.0, 0.0]\nv = [0.0, 12.0, 0.0]\nmaterial = \"green\"\n"
+        );
+    }
+    let scene = kernel_scene(&toml);
+    scene_with_size(scene, size, seed)
+}
+
+fn scene_with_size(mut scene: KernelScene, size: u32, seed: u32) -> KernelScene {
+    scene.params.width = size;
+    scene.params.height = size;
+    scene.params.seed = seed;
+    scene
+}
+
+/// The choice: uniform buffers while the largest array fits both the device's limit and
+/// 64 KiB, storage buffers beyond.
+#[test]
+fn scenes_too_large_for_uniform_buffers_use_storage_buffers() {
+    let cornell = common::cornell_at(16, 0);
+    assert_eq!(
+        SceneBinding::for_scene(&cornell, 65536),
+        SceneBinding::Uniform(SceneCounts::of(&cornell))
+    );
+    // 682 quads of 96 bytes fit in 64 KiB (65472 bytes); 683 do not.
+    let fitting_tiles = 682 - cornell.quads.len() as u32;
+    assert!(matches!(
+        SceneBinding::for_scene(&tiled_cornell(fitting_tiles, 16, 0), 65536),
+        SceneBinding::Uniform(_)
+    ));
+    assert_eq!(
+        SceneBinding::for_scene(&tiled_cornell(fitting_tiles + 1, 16, 0), 65536),
+        SceneBinding::Storage
+    );
+    // A device with a larger limit still gets at most 64 KiB; one with a smaller limit, its own.
+    assert_eq!(MAX_UNIFORM_SCENE_BYTES, 65536);
+    assert_eq!(
+        SceneBinding::for_scene(&tiled_cornell(fitting_tiles + 1, 16, 0), 1 << 30),
+        SceneBinding::Storage
+    );
+    assert_eq!(
+        SceneBinding::for_scene(&cornell, cornell.quads.len() as u64 * 96 - 1),
+        SceneBinding::Storage
+    );
+}
+
+/// A scene over the uniform limit renders through storage buffers and traces the same paths
+/// as the CPU reference (the criterion of tests/gpu_vs_cpu.rs).
+#[test]
+fn large_scene_renders_through_storage_buffers_like_the_cpu() {
+    let Some(ctx) = gpu() else { return };
+    let mut agreement = common::PathAgreement::default();
+    for seed in [1, 2] {
+        let scene = tiled_cornell(700, 64, seed);
+        let mut renderer = GpuRenderer::new(ctx, &scene).unwrap();
+        assert_eq!(renderer.scene_binding(), SceneBinding::Storage);
+        let gpu_image = render_image(&mut renderer, 1, 1).unwrap();
+        agreement.add(&render_cpu(&scene, 1), &gpu_image);
+    }
+    agreement.check(0.99);
+}
