@@ -22,6 +22,18 @@ fn pick_emitter(u: f32) -> u32 {
     return emitter_count() - 1u;
 }
 
+// Whether an emitter is a quad; known at compile time when the scene's emitters are all quads
+// or all spheres, and then the other kind's code is compiled out (see src/shader.rs).
+fn emitter_is_quad(primitive: u32) -> bool {
+    if !HAS_SPHERE_EMITTERS {
+        return true;
+    }
+    if !HAS_QUAD_EMITTERS {
+        return false;
+    }
+    return primitive == PRIMITIVE_QUAD;
+}
+
 fn sphere_contains(s: Sphere, p: vec3<f32>) -> bool {
     let d = p - s.center;
     return dot(d, d) < s.radius * s.radius;
@@ -71,7 +83,7 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     out.primitive = e.primitive;
     out.index = e.index;
-    if e.primitive == PRIMITIVE_QUAD {
+    if emitter_is_quad(e.primitive) {
         let q = quads[e.index];
         let to_light = q.corner + u.x * q.edge_u + u.y * q.edge_v - p;
         let t = length(to_light);
@@ -117,7 +129,7 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
 // The pdf with which sample_light(p, probe) would have produced `dir`, a direction that meets
 // the emitting primitive (primitive, index).
 fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, index: u32) -> f32 {
-    if primitive == PRIMITIVE_QUAD {
+    if emitter_is_quad(primitive) {
         let q = quads[index];
         let cos_light = dot(q.normal, dir);
         let t = (q.plane_offset - dot(q.normal, p)) / cos_light;

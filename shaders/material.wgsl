@@ -40,11 +40,20 @@ struct BsdfSample {
     is_delta: bool,
 }
 
+// Material kinds a scene lacks are compiled out (HAS_*, see src/shader.rs).
+fn is_metal(m: Material) -> bool {
+    return HAS_METAL && m.kind == MATERIAL_METAL;
+}
+
+fn is_dielectric(m: Material) -> bool {
+    return HAS_DIELECTRIC && m.kind == MATERIAL_DIELECTRIC;
+}
+
 // Mirrors, glass and very smooth metal scatter into single directions: light sampling cannot
 // help there, and emitters they see count in full.
 fn is_delta(m: Material) -> bool {
-    return m.kind == MATERIAL_SPECULAR || m.kind == MATERIAL_DIELECTRIC
-        || (m.kind == MATERIAL_METAL && m.alpha < MIN_METAL_ALPHA);
+    return m.kind == MATERIAL_SPECULAR || is_dielectric(m)
+        || (is_metal(m) && m.alpha < MIN_METAL_ALPHA);
 }
 
 fn to_local(v: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
@@ -126,7 +135,7 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> vec3<f3
     if cos_i <= 0.0 || is_delta(m) {
         return vec3<f32>(0.0);
     }
-    if m.kind == MATERIAL_METAL {
+    if is_metal(m) {
         let wo_l = to_local(wo, n);
         let wi_l = to_local(wi, n);
         let h = normalize(wo_l + wi_l);
@@ -142,7 +151,7 @@ fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> f32 {
     if is_delta(m) {
         return 0.0;
     }
-    if m.kind == MATERIAL_METAL {
+    if is_metal(m) {
         return ggx_reflection_pdf(to_local(wo, n), to_local(wi, n), m.alpha);
     }
     return max(dot(wi, n), 0.0) / PI;
@@ -160,7 +169,7 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: 
         out.weight = m.albedo;
         return out;
     }
-    if m.kind == MATERIAL_DIELECTRIC {
+    if is_dielectric(m) {
         // Reflect with the Fresnel probability, else refract: the weights F / F and
         // (1 - F) / (1 - F) cancel, leaving the tint and the radiance scaling eta^2.
         let eta = select(m.ior, 1.0 / m.ior, front_face);
@@ -177,7 +186,7 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: 
         return out;
     }
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
-    if m.kind == MATERIAL_METAL {
+    if is_metal(m) {
         if m.alpha < MIN_METAL_ALPHA {
             out.dir = normalize(reflect(-wo, n));
             out.weight = fresnel_schlick(m.albedo, cos_o);

@@ -29,7 +29,7 @@ fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
 fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let ray = (*path).ray;
     let bounce = (*path).bounce;
-    let light_sampling = params.light_sampling != 0u && emitter_count() > 0u;
+    let light_sampling = LIGHT_SAMPLING && params.light_sampling != 0u && emitter_count() > 0u;
     let hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {

@@ -2,8 +2,8 @@
 //! byte for byte (naga's layouter), so the host and the kernel cannot drift apart.
 
 use glint::shader::{
-    render_kernel_source, render_kernel_source_for, SceneBinding, SceneCounts, RENDER_ENTRY_POINT,
-    WORKGROUP_SIZE,
+    render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
+    SceneCounts, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use glint::shader_types::{Emitter, Material, Params, Quad, Sphere};
 use naga::proc::Layouter;
@@ -190,7 +190,10 @@ fn uniform_scene_kernel_declares_the_uploaded_sizes() {
             emitters: 2,
         },
     ] {
-        let module = validate_source(render_kernel_source_for(SceneBinding::Uniform(counts)));
+        let module = validate_source(render_kernel_source_for(KernelVariant {
+            binding: SceneBinding::Uniform(counts),
+            features: KernelFeatures::ALL,
+        }));
         let mut layouter = Layouter::default();
         layouter.update(module.to_ctx()).unwrap();
         let binding_size = |binding: u32| {
@@ -228,5 +231,31 @@ fn uniform_scene_kernel_declares_the_uploaded_sizes() {
             .max()
             .unwrap()
         );
+    }
+}
+
+/// Every combination of compiled-out features gives a valid kernel, in both bindings.
+#[test]
+fn every_feature_combination_validates() {
+    let counts = SceneCounts {
+        spheres: 2,
+        quads: 6,
+        materials: 5,
+        emitters: 1,
+    };
+    for bits in 0..32u32 {
+        let features = KernelFeatures {
+            light_sampling: bits & 1 != 0,
+            sphere_emitters: bits & 2 != 0,
+            quad_emitters: bits & 4 != 0,
+            metal: bits & 8 != 0,
+            dielectric: bits & 16 != 0,
+        };
+        for binding in [SceneBinding::Storage, SceneBinding::Uniform(counts)] {
+            validate_source(render_kernel_source_for(KernelVariant {
+                binding,
+                features,
+            }));
+        }
     }
 }

@@ -8,7 +8,9 @@ use glint::gpu::GpuRenderer;
 use glint::output::Image;
 use glint::render::render_image;
 use glint::scene::{KernelScene, RenderOverrides, Scene};
-use glint::shader::{SceneBinding, SceneCounts, MAX_UNIFORM_SCENE_BYTES};
+use glint::shader::{
+    KernelFeatures, KernelVariant, SceneBinding, SceneCounts, MAX_UNIFORM_SCENE_BYTES,
+};
 use std::path::Path;
 
 fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
@@ -117,4 +119,89 @@ fn large_scene_renders_through_storage_buffers_like_the_cpu() {
         agreement.add(&render_cpu(&scene, 1), &gpu_image);
     }
     agreement.check(0.99);
+}
+
+/// Kernels with unused features compiled out render exactly what the kernel with everything
+/// renders: the flags only remove code a scene cannot reach. The scenes cover each flag both
+/// ways: light sampling on and off; quad emitters only, sphere emitters only, and both; metal
+/// and glass present and absent.
+#[test]
+fn compiled_out_features_do_not_change_the_image() {
+    let Some(ctx) = gpu() else { return };
+    let mut lit_by_both = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-materials.toml"),
+    )
+    .unwrap();
+    lit_by_both +=
+        "\n[[spheres]]\ncenter = [100.0, 450.0, 300.0]\nradius = 40.0\nmaterial = \"light\"\n";
+    let lit_by_both = scene_with_size(kernel_scene(&lit_by_both), 32, 5);
+    let mut cornell_off = common::cornell_at(32, 6);
+    cornell_off.params.light_sampling = 0;
+    let scenes = [
+        ("cornell, light sampling on", common::cornell_at(32, 6)),
+        ("cornell, light sampling off", cornell_off),
+        ("materials", materials_scene(32, 5)),
+        ("quad and sphere emitters", lit_by_both),
+        ("sphere emitter only", common::floor_under_lamp(32, 2, 3)),
+    ];
+    let mut variants_seen = Vec::new();
+    for (name, scene) in scenes {
+        let fast = GpuRenderer::new(ctx, &scene).unwrap();
+        let variant = fast.variant();
+        variants_seen.push(variant.features);
+        let general = KernelVariant {
+            binding: variant.binding,
+            features: KernelFeatures::ALL,
+        };
+        let a = render_image(&mut { fast }, 2, 2).unwrap();
+        let b = render_image(
+            &mut GpuRenderer::with_variant(ctx, &scene, general).unwrap(),
+            2,
+            2,
+        )
+        .unwrap();
+        let differing = a
+            .pixels
+            .iter()
+            .zip(&b.pixels)
+            .filter(|(x, y)| x != y)
+            .count();
+        eprintln!("{name}: {:?}: {differing} pixels differ", variant.features);
+        assert_eq!(differing, 0, "{name}");
+        assert!(a.pixels.iter().any(|p| p[0] > 0.0), "{name} is black");
+    }
+    // Each flag was off for some scene and on for another.
+    let flags = |f: &KernelFeatures| {
+        [
+            f.light_sampling,
+            f.sphere_emitters,
+            f.quad_emitters,
+            f.metal,
+            f.dielectric,
+        ]
+    };
+    for i in 0..5 {
+        assert!(
+            variants_seen.iter().any(|f| flags(f)[i]),
+            "flag {i} never on"
+        );
+        assert!(
+            variants_seen.iter().any(|f| !flags(f)[i]),
+            "flag {i} never off"
+        );
+    }
+}
+
+/// A kernel without a feature the scene uses is refused, not run with wrong results.
+#[test]
+fn a_kernel_lacking_a_needed_feature_is_refused() {
+    let Some(ctx) = gpu() else { return };
+    let scene = materials_scene(16, 1);
+    let mut features = KernelFeatures::of(&scene);
+    features.dielectric = false;
+    let variant = KernelVariant {
+        binding: SceneBinding::Storage,
+        features,
+    };
+    assert!(GpuRenderer::with_variant(ctx, &scene, variant).is_err());
 }

@@ -4,7 +4,10 @@ use super::context::GpuContext;
 use crate::output::Image;
 use crate::render::{variance_of_mean, Renderer};
 use crate::scene::KernelScene;
-use crate::shader::{render_kernel_source_for, SceneBinding, RENDER_ENTRY_POINT, WORKGROUP_SIZE};
+use crate::shader::{
+    render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding, RENDER_ENTRY_POINT,
+    WORKGROUP_SIZE,
+};
 use crate::shader_types::Params;
 use anyhow::{anyhow, Result};
 use bytemuck::Pod;
@@ -12,7 +15,7 @@ use wgpu::util::DeviceExt;
 
 pub struct GpuRenderer<'a> {
     ctx: &'a GpuContext,
-    scene_binding: SceneBinding,
+    variant: KernelVariant,
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     params: Params,
@@ -72,28 +75,87 @@ fn scene_buffer<T: Pod + Default>(
 }
 
 impl<'a> GpuRenderer<'a> {
-    /// A renderer for `scene`, with its objects in uniform buffers when they fit the device's
-    /// limit and in storage buffers otherwise.
+    /// A renderer for `scene` with the fastest kernel for it: its objects in uniform buffers
+    /// when they fit the device's limit (storage buffers otherwise), and only the features it
+    /// uses compiled in.
     pub fn new(ctx: &'a GpuContext, scene: &KernelScene) -> Result<GpuRenderer<'a>> {
         let max_uniform = ctx.device.limits().max_uniform_buffer_binding_size;
-        Self::with_scene_binding(ctx, scene, SceneBinding::for_scene(scene, max_uniform))
+        Self::with_variant(ctx, scene, KernelVariant::for_scene(scene, max_uniform))
     }
 
-    /// A renderer with the scene bound as `scene_binding` says (tests and benchmarks compare
-    /// the two).
+    /// A renderer with the scene bound as `scene_binding` says and the scene's features (tests
+    /// and benchmarks compare the bindings).
     pub fn with_scene_binding(
         ctx: &'a GpuContext,
         scene: &KernelScene,
         scene_binding: SceneBinding,
     ) -> Result<GpuRenderer<'a>> {
+        let features = KernelFeatures::of(scene);
+        Self::with_variant(
+            ctx,
+            scene,
+            KernelVariant {
+                binding: scene_binding,
+                features,
+            },
+        )
+    }
+
+    /// A renderer running the kernel `variant`, which must cover what `scene` uses.
+    pub fn with_variant(
+        ctx: &'a GpuContext,
+        scene: &KernelScene,
+        variant: KernelVariant,
+    ) -> Result<GpuRenderer<'a>> {
+        if !variant.features.covers(&KernelFeatures::of(scene)) {
+            return Err(anyhow!(
+                "the kernel variant {variant:?} lacks features the scene uses"
+            ));
+        }
         let device = &ctx.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("glint render kernel"),
-            source: wgpu::ShaderSource::Wgsl(render_kernel_source_for(scene_binding).into()),
+            source: wgpu::ShaderSource::Wgsl(render_kernel_source_for(variant).into()),
+        });
+        let scene_binding = variant.binding;
+        // An explicit layout: a variant that compiles out a feature may leave a binding unused,
+        // and an automatic layout would then drop it.
+        let scene_type = match scene_binding {
+            SceneBinding::Storage => wgpu::BufferBindingType::Storage { read_only: true },
+            SceneBinding::Uniform(_) => wgpu::BufferBindingType::Uniform,
+        };
+        let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+        let bind_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene"),
+            entries: &[
+                (0, wgpu::BufferBindingType::Uniform),
+                (1, scene_type),
+                (2, scene_type),
+                (3, scene_type),
+                (4, read_write),
+                (5, read_write),
+                (6, scene_type),
+                (7, read_write),
+            ]
+            .map(|(binding, ty)| wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("glint render"),
+            bind_group_layouts: &[Some(&bind_group_layout)],
+            immediate_size: 0,
         });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("glint render"),
-            layout: None,
+            layout: Some(&pipeline_layout),
             module: &module,
             entry_point: Some(RENDER_ENTRY_POINT),
             compilation_options: Default::default(),
@@ -153,7 +215,7 @@ impl<'a> GpuRenderer<'a> {
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
-            layout: &pipeline.get_bind_group_layout(0),
+            layout: &bind_group_layout,
             entries: &[
                 (0, &params_buffer),
                 (1, &spheres),
@@ -172,7 +234,7 @@ impl<'a> GpuRenderer<'a> {
         ctx.wait_idle()?;
         Ok(GpuRenderer {
             ctx,
-            scene_binding,
+            variant,
             pipeline,
             bind_group,
             params,
@@ -256,7 +318,12 @@ impl<'a> GpuRenderer<'a> {
 
     /// Where the kernel reads the scene from.
     pub fn scene_binding(&self) -> SceneBinding {
-        self.scene_binding
+        self.variant.binding
+    }
+
+    /// The kernel variant this renderer runs.
+    pub fn variant(&self) -> KernelVariant {
+        self.variant
     }
 
     /// The kernel parameters in use (camera, size, counts).
@@ -271,6 +338,11 @@ impl<'a> GpuRenderer<'a> {
         if (params.width, params.height) != size {
             return Err(anyhow!(
                 "set_params cannot change the image size; make a new renderer"
+            ));
+        }
+        if params.light_sampling != 0 && !self.variant.features.light_sampling {
+            return Err(anyhow!(
+                "set_params cannot turn on light sampling compiled out of the kernel; make a new renderer"
             ));
         }
         self.params = params;
