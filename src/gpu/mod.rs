@@ -1,5 +1,6 @@
 //! The GPU path: wgpu on Vulkan, running the WGSL kernel in `shaders/`.
 
+pub mod binding;
 pub mod context;
 pub mod renderer;
 

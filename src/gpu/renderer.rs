@@ -1,5 +1,6 @@
 //! The GPU renderer: scene upload, sample batches, readback of the running sums.
 
+use super::binding::{compute_bind_group, compute_pipeline};
 use super::context::GpuContext;
 use crate::output::Image;
 use crate::render::{variance_of_mean, Renderer};
@@ -113,54 +114,6 @@ impl<'a> GpuRenderer<'a> {
             ));
         }
         let device = &ctx.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("glint render kernel"),
-            source: wgpu::ShaderSource::Wgsl(render_kernel_source_for(variant).into()),
-        });
-        let scene_binding = variant.binding;
-        // An explicit layout: a variant that compiles out a feature may leave a binding unused,
-        // and an automatic layout would then drop it.
-        let scene_type = match scene_binding {
-            SceneBinding::Storage => wgpu::BufferBindingType::Storage { read_only: true },
-            SceneBinding::Uniform(_) => wgpu::BufferBindingType::Uniform,
-        };
-        let read_write = wgpu::BufferBindingType::Storage { read_only: false };
-        let bind_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene"),
-            entries: &[
-                (0, wgpu::BufferBindingType::Uniform),
-                (1, scene_type),
-                (2, scene_type),
-                (3, scene_type),
-                (4, read_write),
-                (5, read_write),
-                (6, scene_type),
-                (7, read_write),
-            ]
-            .map(|(binding, ty)| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }),
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("glint render"),
-            bind_group_layouts: &[Some(&bind_group_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("glint render"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(RENDER_ENTRY_POINT),
-            compilation_options: Default::default(),
-            cache: None,
-        });
         let params = scene.params;
         let pixel_count = params.width as u64 * params.height as u64;
         let accum_size = pixel_count * 16;
@@ -179,9 +132,15 @@ impl<'a> GpuRenderer<'a> {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
-        let usage = match scene_binding {
-            SceneBinding::Storage => wgpu::BufferUsages::STORAGE,
-            SceneBinding::Uniform(_) => wgpu::BufferUsages::UNIFORM,
+        let (usage, scene_type) = match variant.binding {
+            SceneBinding::Storage => (
+                wgpu::BufferUsages::STORAGE,
+                wgpu::BufferBindingType::Storage { read_only: true },
+            ),
+            SceneBinding::Uniform(_) => (
+                wgpu::BufferUsages::UNIFORM,
+                wgpu::BufferBindingType::Uniform,
+            ),
         };
         let spheres = scene_buffer(ctx, "spheres", &scene.spheres, usage);
         let quads = scene_buffer(ctx, "quads", &scene.quads, usage);
@@ -213,24 +172,32 @@ impl<'a> GpuRenderer<'a> {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &bind_group_layout,
-            entries: &[
-                (0, &params_buffer),
-                (1, &spheres),
-                (2, &quads),
-                (3, &materials),
-                (4, &mean_buffer),
-                (5, &m2_buffer),
-                (6, &emitters),
-                (7, &counter_buffer),
-            ]
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }),
+        let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+        let (bind_group_layout, bind_group) = compute_bind_group(
+            device,
+            "scene",
+            &[
+                (0, wgpu::BufferBindingType::Uniform, &params_buffer),
+                (1, scene_type, &spheres),
+                (2, scene_type, &quads),
+                (3, scene_type, &materials),
+                (4, read_write, &mean_buffer),
+                (5, read_write, &m2_buffer),
+                (6, scene_type, &emitters),
+                (7, read_write, &counter_buffer),
+            ],
+        );
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("glint render kernel"),
+            source: wgpu::ShaderSource::Wgsl(render_kernel_source_for(variant).into()),
         });
+        let pipeline = compute_pipeline(
+            device,
+            "glint render",
+            &bind_group_layout,
+            &module,
+            RENDER_ENTRY_POINT,
+        );
         ctx.wait_idle()?;
         Ok(GpuRenderer {
             ctx,

@@ -1,6 +1,7 @@
 //! The display pass: shows a renderer's running mean on a surface (`shaders/display.wgsl`).
 //! It reads the mean buffer where the kernel wrote it, so showing a frame costs no readback.
 
+use crate::gpu::binding::buffer_layout_entry;
 use bytemuck::{Pod, Zeroable};
 
 pub const DISPLAY_SHADER: &str = include_str!("../../shaders/display.wgsl");
@@ -36,26 +37,16 @@ impl DisplayPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                buffer_layout_entry(
+                    0,
+                    wgpu::BufferBindingType::Uniform,
+                    wgpu::ShaderStages::FRAGMENT,
+                ),
+                buffer_layout_entry(
+                    1,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                    wgpu::ShaderStages::FRAGMENT,
+                ),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

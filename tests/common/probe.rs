@@ -1,6 +1,7 @@
 //! Runs the WGSL sampling routines on the GPU through tests/shaders/probe.wgsl.
 
 use bytemuck::{Pod, Zeroable};
+use glint::gpu::binding::{compute_bind_group, compute_pipeline};
 use glint::gpu::renderer::storage_buffer;
 use glint::gpu::GpuContext;
 use glint::scene::KernelScene;
@@ -29,19 +30,6 @@ pub fn probe_module_source() -> String {
     render_kernel_source() + PROBE_SOURCE
 }
 
-fn layout_entry(binding: u32, ty: wgpu::BufferBindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 /// Runs the probe entry point `entry` for `params.count` samples, with `scene` bound as the
 /// kernel's scene (light sampling reads it), and returns what it wrote.
 pub fn run_probe(
@@ -54,33 +42,6 @@ pub fn run_probe(
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("probe"),
         source: wgpu::ShaderSource::Wgsl(probe_module_source().into()),
-    });
-    // An explicit layout with every scene binding, whichever the entry point uses.
-    let read_only = wgpu::BufferBindingType::Storage { read_only: true };
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: None,
-        entries: &[
-            layout_entry(0, wgpu::BufferBindingType::Uniform),
-            layout_entry(1, read_only),
-            layout_entry(2, read_only),
-            layout_entry(3, read_only),
-            layout_entry(6, read_only),
-            layout_entry(10, wgpu::BufferBindingType::Uniform),
-            layout_entry(11, wgpu::BufferBindingType::Storage { read_only: false }),
-        ],
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: None,
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(entry),
-        layout: Some(&pipeline_layout),
-        module: &module,
-        entry_point: Some(entry),
-        compilation_options: Default::default(),
-        cache: None,
     });
     let uniform = |bytes: &[u8]| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -108,23 +69,23 @@ pub fn run_probe(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &layout,
-        entries: &[
-            (0, &scene_params),
-            (1, &spheres),
-            (2, &quads),
-            (3, &materials),
-            (6, &emitters),
-            (10, &probe_params),
-            (11, &out),
-        ]
-        .map(|(binding, buffer)| wgpu::BindGroupEntry {
-            binding,
-            resource: buffer.as_entire_binding(),
-        }),
-    });
+    // Every scene binding, whichever the entry point uses.
+    let read_only = wgpu::BufferBindingType::Storage { read_only: true };
+    let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+    let (layout, bind_group) = compute_bind_group(
+        device,
+        "probe",
+        &[
+            (0, wgpu::BufferBindingType::Uniform, &scene_params),
+            (1, read_only, &spheres),
+            (2, read_only, &quads),
+            (3, read_only, &materials),
+            (6, read_only, &emitters),
+            (10, wgpu::BufferBindingType::Uniform, &probe_params),
+            (11, read_write, &out),
+        ],
+    );
+    let pipeline = compute_pipeline(device, entry, &layout, &module, entry);
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());

@@ -1,0 +1,74 @@
+//! Bind groups of whole buffers, described once as (binding, type, buffer) so the layout and
+//! the bind group cannot disagree, and the compute pipelines that use them.
+
+/// The layout entry of a whole-buffer binding.
+pub fn buffer_layout_entry(
+    binding: u32,
+    ty: wgpu::BufferBindingType,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// An explicit bind group layout and the bind group binding `buffers` to it, for compute.
+/// Explicit, not taken from the pipeline: an automatic layout drops the bindings a shader
+/// does not use, and kernels with features compiled out (or probe entry points) use fewer.
+pub fn compute_bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let entries: Vec<_> = buffers
+        .iter()
+        .map(|&(binding, ty, _)| buffer_layout_entry(binding, ty, wgpu::ShaderStages::COMPUTE))
+        .collect();
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    });
+    let entries: Vec<_> = buffers
+        .iter()
+        .map(|&(binding, _, buffer)| wgpu::BindGroupEntry {
+            binding,
+            resource: buffer.as_entire_binding(),
+        })
+        .collect();
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &layout,
+        entries: &entries,
+    });
+    (layout, group)
+}
+
+/// A compute pipeline running `entry_point` of `module` with `layout` as its one bind group.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    module: &wgpu::ShaderModule,
+    entry_point: &str,
+) -> wgpu::ComputePipeline {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module,
+        entry_point: Some(entry_point),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
