@@ -60,16 +60,19 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let scene = case_scene(&case);
         let result = match (case.device, &gpu) {
             (BenchDevice::Gpu, Some(ctx)) => {
-                let binding = match args.scene_binding {
-                    SceneBindingChoice::Auto => SceneBinding::for_scene(
+                let mut renderer = match args.scene_binding {
+                    SceneBindingChoice::Auto => GpuRenderer::new(ctx, &scene)?,
+                    SceneBindingChoice::Storage => {
+                        GpuRenderer::with_scene_binding(ctx, &scene, SceneBinding::Storage)?
+                    }
+                    SceneBindingChoice::Uniform => GpuRenderer::with_scene_binding(
+                        ctx,
                         &scene,
-                        ctx.device.limits().max_uniform_buffer_binding_size,
-                    ),
-                    SceneBindingChoice::Storage => SceneBinding::Storage,
-                    SceneBindingChoice::Uniform => SceneBinding::Uniform(SceneCounts::of(&scene)),
+                        SceneBinding::Uniform(SceneCounts::of(&scene)),
+                    )?,
                 };
-                let mut renderer = GpuRenderer::with_scene_binding(ctx, &scene, binding)?;
                 renderer.instrument();
+                let binding = renderer.scene_binding();
                 run_case(&mut renderer, case, args.runs as usize)?.with_scene_binding(binding)
             }
             (BenchDevice::Cpu, _) if !args.gpu_only => {
