@@ -33,7 +33,7 @@ pub enum SceneBinding {
     /// Storage buffers: any scene, one kernel for all (`shaders/scene_storage.wgsl`).
     Storage,
     /// Uniform buffers sized for one scene, with the counts compiled in
-    /// (`shaders/scene_uniform.wgsl`): 1.4–2× faster on lavapipe, for scenes that fit.
+    /// (`shaders/scene_uniform.wgsl`): 1.2–2.3× faster on lavapipe, for scenes that fit.
     Uniform(SceneCounts),
 }
 
