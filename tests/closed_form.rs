@@ -69,11 +69,7 @@ fn furnace_is_one_minus_two_to_the_minus_bounces_plus_one() {
 /// The furnace scene shipped in scenes/ is 1 everywhere (to the light-sampling tolerance above).
 #[test]
 fn shipped_furnace_scene_is_one() {
-    let scene = common::scene(
-        &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/furnace.toml"))
-            .unwrap(),
-    )
-    .kernel_scene();
+    let scene = common::shipped_scene("furnace.toml").kernel_scene();
     for (device, image) in render_both(&scene, 2) {
         for p in &image.pixels {
             for c in p {

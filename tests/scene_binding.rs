@@ -1,17 +1,17 @@
-//! The two scene bindings of the kernel (src/shader.rs): uniform buffers sized for the scene,
-//! the fast path, and storage buffers, for scenes too large for uniform buffers. Both must
-//! render what the CPU reference renders.
+//! The kernel variants (src/shader.rs). Two scene bindings: uniform buffers sized for the
+//! scene, the fast path, and storage buffers, for scenes too large for uniform buffers. And
+//! features compiled out where the scene cannot reach them. Every variant must render what the
+//! general kernel and the CPU reference render.
 
 mod common;
-use common::{gpu, kernel_scene, render_cpu};
+use common::{gpu, render_cpu, shipped_scene, shipped_scene_text, sized};
 use glint::gpu::GpuRenderer;
 use glint::output::Image;
 use glint::render::render_image;
-use glint::scene::{KernelScene, RenderOverrides, Scene};
+use glint::scene::KernelScene;
 use glint::shader::{
     KernelFeatures, KernelVariant, SceneBinding, SceneCounts, MAX_UNIFORM_SCENE_BYTES,
 };
-use std::path::Path;
 
 fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
     let ctx = gpu().unwrap();
@@ -21,16 +21,17 @@ fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
 }
 
 fn materials_scene(size: u32, seed: u32) -> KernelScene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-materials.toml"))
-        .unwrap()
-        .with_overrides(&RenderOverrides {
-            width: Some(size),
-            height: Some(size),
-            seed: Some(seed),
-            ..Default::default()
-        })
-        .unwrap()
-        .kernel_scene()
+    sized(shipped_scene("cornell-materials.toml"), size, seed)
+}
+
+/// How many pixels of `a` and `b` are not bit-identical.
+fn differing_pixels(a: &Image, b: &Image) -> usize {
+    assert_eq!(a.pixels.len(), b.pixels.len());
+    a.pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(x, y)| x != y)
+        .count()
 }
 
 /// The same kernel code reads the same numbers from either binding, so every path is the same.
@@ -42,36 +43,21 @@ fn uniform_and_storage_bindings_render_the_same_image() {
     let scene = materials_scene(48, 7);
     let uniform = render_with(&scene, SceneBinding::Uniform(SceneCounts::of(&scene)), 2);
     let storage = render_with(&scene, SceneBinding::Storage, 2);
-    let differing = uniform
-        .pixels
-        .iter()
-        .zip(&storage.pixels)
-        .filter(|(a, b)| a != b)
-        .count();
+    let differing = differing_pixels(&uniform, &storage);
     eprintln!("{differing} of {} pixels differ", uniform.pixels.len());
     assert_eq!(differing, 0);
 }
 
 /// The Cornell box with a grid of `tiles` small green quads in front of the back wall.
 fn tiled_cornell(tiles: u32, size: u32, seed: u32) -> KernelScene {
-    let mut toml =
-        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml"))
-            .unwrap();
+    let mut toml = shipped_scene_text("cornell.toml");
     for i in 0..tiles {
         let (x, y) = (10 + 19 * (i % 28), 10 + 19 * (i / 28));
         toml += &format!(
             "\n[[quads]]\ncorner = [{x}.0, {y}.0, 554.0]\nu = [12.0, 0.0, 0.0]\nv = [0.0, 12.0, 0.0]\nmaterial = \"green\"\n"
         );
     }
-    let scene = kernel_scene(&toml);
-    scene_with_size(scene, size, seed)
-}
-
-fn scene_with_size(mut scene: KernelScene, size: u32, seed: u32) -> KernelScene {
-    scene.params.width = size;
-    scene.params.height = size;
-    scene.params.seed = seed;
-    scene
+    sized(common::scene(&toml), size, seed)
 }
 
 /// The choice: uniform buffers while the largest array fits both the device's limit and
@@ -128,13 +114,10 @@ fn large_scene_renders_through_storage_buffers_like_the_cpu() {
 #[test]
 fn compiled_out_features_do_not_change_the_image() {
     let Some(ctx) = gpu() else { return };
-    let mut lit_by_both = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-materials.toml"),
-    )
-    .unwrap();
+    let mut lit_by_both = shipped_scene_text("cornell-materials.toml");
     lit_by_both +=
         "\n[[spheres]]\ncenter = [100.0, 450.0, 300.0]\nradius = 40.0\nmaterial = \"light\"\n";
-    let lit_by_both = scene_with_size(kernel_scene(&lit_by_both), 32, 5);
+    let lit_by_both = sized(common::scene(&lit_by_both), 32, 5);
     let mut cornell_off = common::cornell_at(32, 6);
     cornell_off.params.light_sampling = 0;
     let scenes = [
@@ -160,12 +143,7 @@ fn compiled_out_features_do_not_change_the_image() {
             2,
         )
         .unwrap();
-        let differing = a
-            .pixels
-            .iter()
-            .zip(&b.pixels)
-            .filter(|(x, y)| x != y)
-            .count();
+        let differing = differing_pixels(&a, &b);
         eprintln!("{name}: {:?}: {differing} pixels differ", variant.features);
         assert_eq!(differing, 0, "{name}");
         assert!(a.pixels.iter().any(|p| p[0] > 0.0), "{name} is black");

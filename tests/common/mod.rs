@@ -58,14 +58,29 @@ pub fn render_both(scene: &KernelScene, spp: u32) -> Vec<(&'static str, Image)> 
     out
 }
 
-/// The Cornell box from scenes/cornell.toml.
-pub fn cornell() -> Scene {
-    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.toml")).unwrap()
+/// The text of a scene file shipped in scenes/.
+pub fn shipped_scene_text(name: &str) -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name),
+    )
+    .unwrap()
 }
 
-/// The Cornell box at `size`², with `seed`.
-pub fn cornell_at(size: u32, seed: u32) -> KernelScene {
-    cornell()
+/// A scene file shipped in scenes/, loaded as a user's would be.
+pub fn shipped_scene(name: &str) -> Scene {
+    Scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// `scene` rendered at `size`², with `seed`.
+pub fn sized(scene: Scene, size: u32, seed: u32) -> KernelScene {
+    scene
         .with_overrides(&glint::scene::RenderOverrides {
             width: Some(size),
             height: Some(size),
@@ -74,6 +89,16 @@ pub fn cornell_at(size: u32, seed: u32) -> KernelScene {
         })
         .unwrap()
         .kernel_scene()
+}
+
+/// The Cornell box from scenes/cornell.toml.
+pub fn cornell() -> Scene {
+    shipped_scene("cornell.toml")
+}
+
+/// The Cornell box at `size`², with `seed`.
+pub fn cornell_at(size: u32, seed: u32) -> KernelScene {
+    sized(cornell(), size, seed)
 }
 
 /// A diffuse floor of albedo 0.6 under an emitting sphere (radiance 4, radius 1, centre 2 above
