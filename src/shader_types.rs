@@ -104,3 +104,54 @@ pub struct Emitter {
     pub cdf: f32,
     pub probability: f32,
 }
+
+/// One wave of the wavefront layout (`shaders/wavefront.wgsl`, `src/gpu/wavefront.rs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct WaveParams {
+    /// Global index of the wave's first sample, and samples per pixel in the wave.
+    pub sample_first: u32,
+    pub samples_per_pixel: u32,
+    /// Samples of the batch traced before this wave.
+    pub batch_done: u32,
+    /// 1 on the batch's last wave, which merges the batch into the accumulators.
+    pub last_wave: u32,
+}
+
+/// A path between wavefront stages; only the GPU reads it, the host sizes buffers by it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct WavePath {
+    pub origin: [f32; 3],
+    pub pixel: u32,
+    pub dir: [f32; 3],
+    pub sample: u32,
+    pub throughput: [f32; 3],
+    pub bsdf_pdf_of_ray: f32,
+    pub radiance: [f32; 3],
+    pub bounce: u32,
+    pub ray_start: [f32; 3],
+    pub came_from_delta: u32,
+}
+
+/// A queued shadow ray of the wavefront layout; only the GPU reads it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct WaveShadow {
+    pub origin: [f32; 3],
+    pub path: u32,
+    pub dir: [f32; 3],
+    pub light_primitive: u32,
+    pub contribution: [f32; 3],
+    pub light_index: u32,
+}
+
+/// The wavefront's queue lengths (`WaveControl` in WGSL).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct WaveControl {
+    /// Entries appended to the path queue and to the shadow queue.
+    pub appended: [u32; 2],
+    pub live_paths: u32,
+    pub shadows: u32,
+}
