@@ -25,33 +25,13 @@ fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
     return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true);
 }
 
-// Next-event estimation's shadow ray: `contribution` counts when the ray's first hit is the
-// light it was aimed at (`light_primitive`, `light_index`).
-struct ShadowRay {
-    ray: Ray,
-    contribution: vec3<f32>,
-    light_primitive: u32,
-    light_index: u32,
-    pending: bool,
-}
-
-fn no_shadow_ray() -> ShadowRay {
-    return ShadowRay(Ray(vec3<f32>(0.0), vec3<f32>(0.0)), vec3<f32>(0.0), 0u, 0u, false);
-}
-
-// Whether a shadow ray reaches the light it was aimed at.
-fn reaches_light(ray: Ray, light_primitive: u32, light_index: u32) -> bool {
-    let blocker = intersect_scene(ray);
-    return blocker.t != NO_HIT && blocker.primitive == light_primitive && blocker.index == light_index;
-}
-
-// Everything after the intersection: emission, the shadow ray of next-event estimation (left
-// in `shadow` for the caller to trace) and the next direction. True when the path has ended.
-// The megakernel (path_step) and the wavefront's stages (wavefront.wgsl) share it.
-fn shade(path: ptr<function, PathState>, hit: Hit, pixel: u32, sample: u32, shadow: ptr<function, ShadowRay>) -> bool {
+// Traces one segment of the path (and its shadow ray); true when the path has ended.
+fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let ray = (*path).ray;
     let bounce = (*path).bounce;
     let light_sampling = LIGHT_SAMPLING && params.light_sampling != 0u && emitter_count() > 0u;
+    let hit = intersect_scene(ray);
+    segments += 1u;
     if hit.t == NO_HIT {
         (*path).radiance += (*path).throughput * params.background;
         return true;
@@ -81,9 +61,12 @@ fn shade(path: ptr<function, PathState>, hit: Hit, pixel: u32, sample: u32, shad
         if light.pdf > 0.0 {
             let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
             if any(f_cos > vec3<f32>(0.0)) {
-                let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
-                let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
-                *shadow = ShadowRay(Ray(origin, light.dir), contribution, light.primitive, light.index, true);
+                let blocker = intersect_scene(Ray(origin, light.dir));
+                segments += 1u;
+                if blocker.t != NO_HIT && blocker.primitive == light.primitive && blocker.index == light.index {
+                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                    (*path).radiance += (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
+                }
             }
         }
     }
@@ -112,21 +95,6 @@ fn shade(path: ptr<function, PathState>, hit: Hit, pixel: u32, sample: u32, shad
     (*path).ray_start = p;
     (*path).bounce = bounce + 1u;
     return false;
-}
-
-// Traces one segment of the path (and its shadow ray); true when the path has ended.
-fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
-    let hit = intersect_scene((*path).ray);
-    segments += 1u;
-    var shadow = no_shadow_ray();
-    let ended = shade(path, hit, pixel, sample, &shadow);
-    if LIGHT_SAMPLING && shadow.pending {
-        segments += 1u;
-        if reaches_light(shadow.ray, shadow.light_primitive, shadow.light_index) {
-            (*path).radiance += shadow.contribution;
-        }
-    }
-    return ended;
 }
 
 // Radiance carried by one camera path through pixel (px, py).

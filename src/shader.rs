@@ -8,7 +8,7 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 8] = [
+pub const SHADER_PARTS: [(&str, &str); 7] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -16,7 +16,6 @@ pub const SHADER_PARTS: [(&str, &str); 8] = [
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("trace.wgsl", include_str!("../shaders/trace.wgsl")),
-    ("wavefront.wgsl", include_str!("../shaders/wavefront.wgsl")),
 ];
 
 const SCENE_STORAGE: &str = include_str!("../shaders/scene_storage.wgsl");

@@ -38,9 +38,6 @@ pub struct BenchArgs {
     /// Where the GPU kernel reads the scene from, to compare the two kernels.
     #[arg(long, value_enum, default_value_t = SceneBindingChoice::Auto)]
     pub scene_binding: SceneBindingChoice,
-    /// Trace with the wavefront layout, this many paths in flight per wave.
-    #[arg(long)]
-    pub wavefront: Option<u32>,
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
@@ -75,9 +72,6 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     )?,
                 };
                 renderer.instrument();
-                if let Some(paths) = args.wavefront {
-                    renderer.use_wavefront(paths)?;
-                }
                 let binding = renderer.scene_binding();
                 run_case(&mut renderer, case, args.runs as usize)?.with_scene_binding(binding)
             }

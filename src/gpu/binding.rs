@@ -27,54 +27,27 @@ pub fn compute_bind_group(
     label: &str,
     buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
-    let types: Vec<_> = buffers
-        .iter()
-        .map(|&(binding, ty, _)| (binding, ty))
-        .collect();
-    let layout = compute_bind_group_layout(device, label, &types);
-    let buffers: Vec<_> = buffers
-        .iter()
-        .map(|&(binding, _, buffer)| (binding, buffer))
-        .collect();
-    let group = bind_buffers(device, label, &layout, &buffers);
-    (layout, group)
-}
-
-/// A bind group layout of whole buffers for compute, from (binding, type) pairs.
-pub fn compute_bind_group_layout(
-    device: &wgpu::Device,
-    label: &str,
-    types: &[(u32, wgpu::BufferBindingType)],
-) -> wgpu::BindGroupLayout {
-    let entries: Vec<_> = types
-        .iter()
-        .map(|&(binding, ty)| buffer_layout_entry(binding, ty, wgpu::ShaderStages::COMPUTE))
-        .collect();
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &entries,
-    })
-}
-
-/// A bind group of whole buffers for `layout`, from (binding, buffer) pairs.
-pub fn bind_buffers(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    buffers: &[(u32, &wgpu::Buffer)],
-) -> wgpu::BindGroup {
     let entries: Vec<_> = buffers
         .iter()
-        .map(|&(binding, buffer)| wgpu::BindGroupEntry {
+        .map(|&(binding, ty, _)| buffer_layout_entry(binding, ty, wgpu::ShaderStages::COMPUTE))
+        .collect();
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    });
+    let entries: Vec<_> = buffers
+        .iter()
+        .map(|&(binding, _, buffer)| wgpu::BindGroupEntry {
             binding,
             resource: buffer.as_entire_binding(),
         })
         .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
-        layout,
+        layout: &layout,
         entries: &entries,
-    })
+    });
+    (layout, group)
 }
 
 /// A compute pipeline running `entry_point` of `module` with `layout` as its one bind group.
@@ -85,22 +58,9 @@ pub fn compute_pipeline(
     module: &wgpu::ShaderModule,
     entry_point: &str,
 ) -> wgpu::ComputePipeline {
-    compute_pipeline_with_groups(device, label, &[layout], module, entry_point)
-}
-
-/// A compute pipeline running `entry_point` of `module` with bind groups 0, 1, ... laid out
-/// as `layouts` say.
-pub fn compute_pipeline_with_groups(
-    device: &wgpu::Device,
-    label: &str,
-    layouts: &[&wgpu::BindGroupLayout],
-    module: &wgpu::ShaderModule,
-    entry_point: &str,
-) -> wgpu::ComputePipeline {
-    let layouts: Vec<_> = layouts.iter().map(|&l| Some(l)).collect();
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
-        bind_group_layouts: &layouts,
+        bind_group_layouts: &[Some(layout)],
         immediate_size: 0,
     });
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

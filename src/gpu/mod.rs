@@ -3,7 +3,6 @@
 pub mod binding;
 pub mod context;
 pub mod renderer;
-pub mod wavefront;
 
 pub use context::{GpuContext, GpuUnavailable};
 pub use renderer::GpuRenderer;

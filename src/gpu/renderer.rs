@@ -2,7 +2,6 @@
 
 use super::binding::{compute_bind_group, compute_pipeline};
 use super::context::GpuContext;
-use super::wavefront::Wavefront;
 use crate::output::Image;
 use crate::render::{variance_of_mean, Renderer};
 use crate::scene::KernelScene;
@@ -32,10 +31,6 @@ pub struct GpuRenderer<'a> {
     counter_buffer: wgpu::Buffer,
     /// Benchmark instrumentation, off unless asked for: it reads back after every batch.
     instruments: Option<Instruments>,
-    scene_layout: wgpu::BindGroupLayout,
-    module: wgpu::ShaderModule,
-    /// The wavefront layout's stages, when it replaces the megakernel.
-    wavefront: Option<Wavefront>,
 }
 
 /// Timestamp queries and the segment count, read after each batch.
@@ -217,22 +212,7 @@ impl<'a> GpuRenderer<'a> {
             samples: 0,
             counter_buffer,
             instruments: None,
-            scene_layout: bind_group_layout,
-            module,
-            wavefront: None,
         })
-    }
-
-    /// Traces with the wavefront layout from now on, `wave_paths` paths in flight at most.
-    pub fn use_wavefront(&mut self, wave_paths: u32) -> Result<()> {
-        self.wavefront = Some(Wavefront::new(
-            &self.ctx.device,
-            &self.scene_layout,
-            &self.module,
-            &self.params,
-            wave_paths,
-        )?);
-        self.ctx.wait_idle()
     }
 
     /// Turns on benchmark instrumentation: after every batch, the renderer reads back the
@@ -365,59 +345,32 @@ impl Renderer for GpuRenderer<'_> {
         self.ctx
             .queue
             .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         let timestamps = self
             .instruments
             .as_ref()
             .and_then(|i| i.timestamps.as_ref());
-        if count == 0 {
-            return Ok(());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("render"),
+                timestamp_writes: timestamps.map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(
+                self.params.width.div_ceil(WORKGROUP_SIZE.0),
+                self.params.height.div_ceil(WORKGROUP_SIZE.1),
+                1,
+            );
         }
-        // The megakernel is one dispatch (`None`); the wavefront one submit per wave, each
-        // with its own wave parameters.
-        let waves: Vec<_> = match &self.wavefront {
-            Some(wavefront) => wavefront.plan(&self.params).into_iter().map(Some).collect(),
-            None => vec![None],
-        };
-        let submits = waves.len();
-        for (i, wave) in waves.iter().enumerate() {
-            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("render"),
-                    // The batch's first pass writes the start time, its last the end time.
-                    timestamp_writes: timestamps.filter(|_| i == 0 || i + 1 == submits).map(
-                        |(set, _)| wgpu::ComputePassTimestampWrites {
-                            query_set: set,
-                            beginning_of_pass_write_index: (i == 0).then_some(0),
-                            end_of_pass_write_index: (i + 1 == submits).then_some(1),
-                        },
-                    ),
-                });
-                pass.set_bind_group(0, &self.bind_group, &[]);
-                match (&self.wavefront, wave) {
-                    (Some(wavefront), Some(wave)) => {
-                        wavefront.write_wave(&self.ctx.queue, wave);
-                        let shadows =
-                            self.variant.features.light_sampling && self.params.light_sampling != 0;
-                        wavefront.record(&mut pass, &self.params, wave, shadows);
-                    }
-                    _ => {
-                        pass.set_pipeline(&self.pipeline);
-                        pass.dispatch_workgroups(
-                            self.params.width.div_ceil(WORKGROUP_SIZE.0),
-                            self.params.height.div_ceil(WORKGROUP_SIZE.1),
-                            1,
-                        );
-                    }
-                }
-            }
-            if i + 1 == submits {
-                if let Some((set, resolve)) = timestamps {
-                    encoder.resolve_query_set(set, 0..2, resolve, 0);
-                }
-            }
-            self.ctx.queue.submit([encoder.finish()]);
+        if let Some((set, resolve)) = timestamps {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
         }
+        self.ctx.queue.submit([encoder.finish()]);
         self.ctx.wait_idle()?;
         self.samples += count;
         self.read_instruments()
