@@ -62,26 +62,43 @@ fn hit_quad(q: Quad, ray: Ray) -> f32 {
     return t;
 }
 
-fn intersect_scene(ray: Ray) -> Hit {
-    var best_t = NO_HIT;
-    var best_index = 0u;
-    var best_is_sphere = false;
+// The nearest primitive a ray meets, without the hit's point, normal and material: all a
+// shadow ray needs. (On lavapipe all code in the path loop costs time, taken or not.)
+struct ClosestPrimitive {
+    // NO_HIT when the ray meets nothing.
+    t: f32,
+    is_sphere: bool,
+    index: u32,
+}
+
+fn closest_primitive(ray: Ray) -> ClosestPrimitive {
+    var best = ClosestPrimitive(NO_HIT, false, 0u);
     for (var i = 0u; i < sphere_count(); i++) {
         let t = hit_sphere(spheres[i], ray);
-        if t < best_t {
-            best_t = t;
-            best_index = i;
-            best_is_sphere = true;
+        if t < best.t {
+            best = ClosestPrimitive(t, true, i);
         }
     }
     for (var i = 0u; i < quad_count(); i++) {
         let t = hit_quad(quads[i], ray);
-        if t < best_t {
-            best_t = t;
-            best_index = i;
-            best_is_sphere = false;
+        if t < best.t {
+            best = ClosestPrimitive(t, false, i);
         }
     }
+    return best;
+}
+
+// Whether the first thing `ray` meets is the primitive (primitive, index).
+fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
+    let closest = closest_primitive(ray);
+    return closest.t != NO_HIT && closest.is_sphere == (primitive == PRIMITIVE_SPHERE) && closest.index == index;
+}
+
+fn intersect_scene(ray: Ray) -> Hit {
+    let closest = closest_primitive(ray);
+    let best_t = closest.t;
+    let best_index = closest.index;
+    let best_is_sphere = closest.is_sphere;
     var hit: Hit;
     hit.t = best_t;
     if best_t == NO_HIT {

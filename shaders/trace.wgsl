@@ -61,9 +61,8 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         if light.pdf > 0.0 {
             let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
             if any(f_cos > vec3<f32>(0.0)) {
-                let blocker = intersect_scene(Ray(origin, light.dir));
                 segments += 1u;
-                if blocker.t != NO_HIT && blocker.primitive == light.primitive && blocker.index == light.index {
+                if first_hit_is(Ray(origin, light.dir), light.primitive, light.index) {
                     let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
                     (*path).radiance += (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
                 }

@@ -1,7 +1,10 @@
 //! Ray-sphere and ray-quad intersection on the CPU mirror, including the awkward cases.
 
 use glam::Vec3;
-use glint::cpu::intersect::{hit_quad, hit_sphere, intersect_scene, offset_ray_origin, NO_HIT};
+use glint::cpu::intersect::{
+    closest_primitive, first_hit_is, hit_quad, hit_sphere, intersect_scene, offset_ray_origin,
+    NO_HIT,
+};
 use glint::cpu::Ray;
 use glint::scene::{Material, MaterialKind, Quad as SceneQuad, Scene};
 use glint::shader_types::{Quad, Sphere};
@@ -173,6 +176,53 @@ fn nearest_hit_wins_and_the_normal_faces_the_ray() {
         intersect_scene(&spheres, &quads, &ray([0.0; 3], [0.0, 1.0, 0.0])).t,
         NO_HIT
     );
+}
+
+/// Shadow rays ask only which primitive comes first; it must be the one the full
+/// intersection finds, including when the nearer of two is a sphere or a quad, and for misses.
+#[test]
+fn shadow_test_agrees_with_the_full_intersection() {
+    let spheres = [sphere([0.0, 0.0, 10.0], 1.0), sphere([0.0, 0.0, 5.0], 1.0)];
+    let quads = [
+        quad([-5.0, -5.0, 20.0], [10.0, 0.0, 0.0], [0.0, 10.0, 0.0]),
+        quad([-5.0, -5.0, 7.0], [10.0, 0.0, 0.0], [0.0, 4.0, 0.0]),
+    ];
+    let mut met = [0usize; 4];
+    for i in 0..2000 {
+        // Directions spread over the sphere (a Fibonacci lattice), from two origins.
+        let z = 1.0 - (i as f32 + 0.5) / 1000.0 % 2.0;
+        let phi = i as f32 * 2.399_963;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let origin = if i % 2 == 0 {
+            [0.0; 3]
+        } else {
+            [0.5, 0.3, 7.5]
+        };
+        let ray = ray(origin, [r * phi.cos(), r * phi.sin(), z]);
+        let hit = intersect_scene(&spheres, &quads, &ray);
+        let closest = closest_primitive(&spheres, &quads, &ray);
+        assert_eq!(closest.t, hit.t);
+        if hit.t == NO_HIT {
+            met[3] += 1;
+            continue;
+        }
+        met[hit.primitive as usize] += 1;
+        assert!(first_hit_is(
+            &spheres,
+            &quads,
+            &ray,
+            hit.primitive,
+            hit.index
+        ));
+        for (primitive, count) in [(0, spheres.len()), (1, quads.len())] {
+            for index in 0..count as u32 {
+                let same = (primitive, index) == (hit.primitive, hit.index);
+                assert_eq!(first_hit_is(&spheres, &quads, &ray, primitive, index), same);
+            }
+        }
+    }
+    // Rays met spheres, quads and nothing, so every branch was compared.
+    assert!(met[0] > 20 && met[1] > 20 && met[3] > 20, "{met:?}");
 }
 
 /// A ray leaving a surface from an offset origin never re-hits that surface, at the scale of

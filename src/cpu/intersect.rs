@@ -70,27 +70,64 @@ pub fn hit_quad(q: &Quad, ray: &Ray) -> f32 {
     t
 }
 
-/// The nearest hit of `ray` among all spheres and quads; `t == NO_HIT` when there is none.
-pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
-    let mut best_t = NO_HIT;
-    let mut best_index = 0usize;
-    let mut best_is_sphere = false;
+/// The nearest primitive a ray meets, without the hit's point, normal and material: all a
+/// shadow ray needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClosestPrimitive {
+    /// `NO_HIT` when the ray meets nothing.
+    pub t: f32,
+    pub is_sphere: bool,
+    pub index: u32,
+}
+
+pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> ClosestPrimitive {
+    let mut best = ClosestPrimitive {
+        t: NO_HIT,
+        is_sphere: false,
+        index: 0,
+    };
     for (i, s) in spheres.iter().enumerate() {
         let t = hit_sphere(s, ray);
-        if t < best_t {
-            best_t = t;
-            best_index = i;
-            best_is_sphere = true;
+        if t < best.t {
+            best = ClosestPrimitive {
+                t,
+                is_sphere: true,
+                index: i as u32,
+            };
         }
     }
     for (i, q) in quads.iter().enumerate() {
         let t = hit_quad(q, ray);
-        if t < best_t {
-            best_t = t;
-            best_index = i;
-            best_is_sphere = false;
+        if t < best.t {
+            best = ClosestPrimitive {
+                t,
+                is_sphere: false,
+                index: i as u32,
+            };
         }
     }
+    best
+}
+
+/// Whether the first thing `ray` meets is the primitive (`primitive`, `index`).
+pub fn first_hit_is(
+    spheres: &[Sphere],
+    quads: &[Quad],
+    ray: &Ray,
+    primitive: u32,
+    index: u32,
+) -> bool {
+    let closest = closest_primitive(spheres, quads, ray);
+    closest.t != NO_HIT
+        && closest.is_sphere == (primitive == PRIMITIVE_SPHERE)
+        && closest.index == index
+}
+
+/// The nearest hit of `ray` among all spheres and quads; `t == NO_HIT` when there is none.
+pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
+    let closest = closest_primitive(spheres, quads, ray);
+    let (best_t, best_index, best_is_sphere) =
+        (closest.t, closest.index as usize, closest.is_sphere);
     if best_t == NO_HIT {
         return Hit {
             t: NO_HIT,

@@ -1,7 +1,7 @@
 //! Path tracing (WGSL side: `shaders/trace.wgsl`).
 
 use super::camera::camera_ray;
-use super::intersect::{intersect_scene, offset_ray_origin, NO_HIT};
+use super::intersect::{first_hit_is, intersect_scene, offset_ray_origin, NO_HIT};
 use super::lights::{light_pdf, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
@@ -104,12 +104,14 @@ pub fn path_step(
                     origin,
                     dir: light.dir,
                 };
-                let blocker = intersect_scene(scene.spheres, scene.quads, &shadow);
                 *segments += 1;
-                if blocker.t != NO_HIT
-                    && blocker.primitive == light.primitive
-                    && blocker.index == light.index
-                {
+                if first_hit_is(
+                    scene.spheres,
+                    scene.quads,
+                    &shadow,
+                    light.primitive,
+                    light.index,
+                ) {
                     let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
                     path.radiance +=
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);
