@@ -67,22 +67,23 @@ fn hit_quad(q: Quad, ray: Ray) -> f32 {
 struct ClosestPrimitive {
     // NO_HIT when the ray meets nothing.
     t: f32,
-    is_sphere: bool,
+    // PRIMITIVE_SPHERE or PRIMITIVE_QUAD, and its index.
+    primitive: u32,
     index: u32,
 }
 
 fn closest_primitive(ray: Ray) -> ClosestPrimitive {
-    var best = ClosestPrimitive(NO_HIT, false, 0u);
+    var best = ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
     for (var i = 0u; i < sphere_count(); i++) {
         let t = hit_sphere(spheres[i], ray);
         if t < best.t {
-            best = ClosestPrimitive(t, true, i);
+            best = ClosestPrimitive(t, PRIMITIVE_SPHERE, i);
         }
     }
     for (var i = 0u; i < quad_count(); i++) {
         let t = hit_quad(quads[i], ray);
         if t < best.t {
-            best = ClosestPrimitive(t, false, i);
+            best = ClosestPrimitive(t, PRIMITIVE_QUAD, i);
         }
     }
     return best;
@@ -91,33 +92,30 @@ fn closest_primitive(ray: Ray) -> ClosestPrimitive {
 // Whether the first thing `ray` meets is the primitive (primitive, index).
 fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
     let closest = closest_primitive(ray);
-    return closest.t != NO_HIT && closest.is_sphere == (primitive == PRIMITIVE_SPHERE) && closest.index == index;
+    return closest.t != NO_HIT && closest.primitive == primitive && closest.index == index;
 }
 
 fn intersect_scene(ray: Ray) -> Hit {
     let closest = closest_primitive(ray);
-    let best_t = closest.t;
-    let best_index = closest.index;
-    let best_is_sphere = closest.is_sphere;
     var hit: Hit;
-    hit.t = best_t;
-    if best_t == NO_HIT {
+    hit.t = closest.t;
+    if closest.t == NO_HIT {
         return hit;
     }
-    hit.primitive = select(PRIMITIVE_QUAD, PRIMITIVE_SPHERE, best_is_sphere);
-    hit.index = best_index;
+    hit.primitive = closest.primitive;
+    hit.index = closest.index;
     var outward: vec3<f32>;
-    if best_is_sphere {
-        let s = spheres[best_index];
+    if closest.primitive == PRIMITIVE_SPHERE {
+        let s = spheres[closest.index];
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
-        outward = normalize(ray.origin + best_t * ray.dir - s.center);
+        outward = normalize(ray.origin + closest.t * ray.dir - s.center);
         hit.position = s.center + s.radius * outward;
         hit.material = s.material;
     } else {
-        outward = quads[best_index].normal;
-        hit.position = ray.origin + best_t * ray.dir;
-        hit.material = quads[best_index].material;
+        outward = quads[closest.index].normal;
+        hit.position = ray.origin + closest.t * ray.dir;
+        hit.material = quads[closest.index].material;
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;
     hit.normal = select(-outward, outward, hit.front_face);

@@ -187,7 +187,8 @@ fn shadow_test_agrees_with_the_full_intersection() {
         quad([-5.0, -5.0, 20.0], [10.0, 0.0, 0.0], [0.0, 10.0, 0.0]),
         quad([-5.0, -5.0, 7.0], [10.0, 0.0, 0.0], [0.0, 4.0, 0.0]),
     ];
-    let mut met = [0usize; 4];
+    // Rays that met a sphere, a quad, nothing.
+    let mut met = [0usize; 3];
     for i in 0..2000 {
         // Directions spread over the sphere (a Fibonacci lattice), from two origins.
         let z = 1.0 - (i as f32 + 0.5) / 1000.0 % 2.0;
@@ -203,17 +204,10 @@ fn shadow_test_agrees_with_the_full_intersection() {
         let closest = closest_primitive(&spheres, &quads, &ray);
         assert_eq!(closest.t, hit.t);
         if hit.t == NO_HIT {
-            met[3] += 1;
+            met[2] += 1;
             continue;
         }
         met[hit.primitive as usize] += 1;
-        assert!(first_hit_is(
-            &spheres,
-            &quads,
-            &ray,
-            hit.primitive,
-            hit.index
-        ));
         for (primitive, count) in [(0, spheres.len()), (1, quads.len())] {
             for index in 0..count as u32 {
                 let same = (primitive, index) == (hit.primitive, hit.index);
@@ -222,7 +216,7 @@ fn shadow_test_agrees_with_the_full_intersection() {
         }
     }
     // Rays met spheres, quads and nothing, so every branch was compared.
-    assert!(met[0] > 20 && met[1] > 20 && met[3] > 20, "{met:?}");
+    assert!(met.iter().all(|&n| n > 20), "{met:?}");
 }
 
 /// A ray leaving a surface from an offset origin never re-hits that surface, at the scale of

@@ -76,14 +76,15 @@ pub fn hit_quad(q: &Quad, ray: &Ray) -> f32 {
 pub struct ClosestPrimitive {
     /// `NO_HIT` when the ray meets nothing.
     pub t: f32,
-    pub is_sphere: bool,
+    /// `PRIMITIVE_SPHERE` or `PRIMITIVE_QUAD`, and its index.
+    pub primitive: u32,
     pub index: u32,
 }
 
 pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> ClosestPrimitive {
     let mut best = ClosestPrimitive {
         t: NO_HIT,
-        is_sphere: false,
+        primitive: PRIMITIVE_QUAD,
         index: 0,
     };
     for (i, s) in spheres.iter().enumerate() {
@@ -91,7 +92,7 @@ pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Close
         if t < best.t {
             best = ClosestPrimitive {
                 t,
-                is_sphere: true,
+                primitive: PRIMITIVE_SPHERE,
                 index: i as u32,
             };
         }
@@ -101,7 +102,7 @@ pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Close
         if t < best.t {
             best = ClosestPrimitive {
                 t,
-                is_sphere: false,
+                primitive: PRIMITIVE_QUAD,
                 index: i as u32,
             };
         }
@@ -118,17 +119,13 @@ pub fn first_hit_is(
     index: u32,
 ) -> bool {
     let closest = closest_primitive(spheres, quads, ray);
-    closest.t != NO_HIT
-        && closest.is_sphere == (primitive == PRIMITIVE_SPHERE)
-        && closest.index == index
+    closest.t != NO_HIT && closest.primitive == primitive && closest.index == index
 }
 
 /// The nearest hit of `ray` among all spheres and quads; `t == NO_HIT` when there is none.
 pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
     let closest = closest_primitive(spheres, quads, ray);
-    let (best_t, best_index, best_is_sphere) =
-        (closest.t, closest.index as usize, closest.is_sphere);
-    if best_t == NO_HIT {
+    if closest.t == NO_HIT {
         return Hit {
             t: NO_HIT,
             position: Vec3::ZERO,
@@ -139,37 +136,33 @@ pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
             index: 0,
         };
     }
-    let (outward, position, material) = if best_is_sphere {
-        let s = &spheres[best_index];
+    let (outward, position, material) = if closest.primitive == PRIMITIVE_SPHERE {
+        let s = &spheres[closest.index as usize];
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
-        let outward = (ray.origin + best_t * ray.dir - Vec3::from(s.center)).normalize();
+        let outward = (ray.origin + closest.t * ray.dir - Vec3::from(s.center)).normalize();
         (
             outward,
             Vec3::from(s.center) + s.radius * outward,
             s.material,
         )
     } else {
-        let q = &quads[best_index];
+        let q = &quads[closest.index as usize];
         (
             Vec3::from(q.normal),
-            ray.origin + best_t * ray.dir,
+            ray.origin + closest.t * ray.dir,
             q.material,
         )
     };
     let front_face = outward.dot(ray.dir) < 0.0;
     Hit {
-        t: best_t,
+        t: closest.t,
         position,
         normal: if front_face { outward } else { -outward },
         material,
         front_face,
-        primitive: if best_is_sphere {
-            PRIMITIVE_SPHERE
-        } else {
-            PRIMITIVE_QUAD
-        },
-        index: best_index as u32,
+        primitive: closest.primitive,
+        index: closest.index,
     }
 }
 
