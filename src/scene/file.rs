@@ -1,0 +1,111 @@
+//! The scene file as written: serde structs that mirror the TOML, with spans for messages.
+//! Integers are accepted where reals are meant; unknown fields are errors.
+
+use serde::de::{self, Deserializer, Visitor};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use toml::Spanned;
+
+/// 1-based line and column (in characters) of a byte offset.
+pub(super) fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, text[line_start..offset].chars().count() + 1)
+}
+
+/// A number: TOML integers are accepted where reals are meant (`radius = 90`).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Real(pub(super) f64);
+
+impl<'de> Deserialize<'de> for Real {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct RealVisitor;
+        impl Visitor<'_> for RealVisitor {
+            type Value = Real;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number")
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Real, E> {
+                Ok(Real(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Real, E> {
+                Ok(Real(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Real, E> {
+                Ok(Real(v as f64))
+            }
+        }
+        d.deserialize_any(RealVisitor)
+    }
+}
+
+pub(super) type S<T> = Spanned<T>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SceneToml {
+    pub(super) camera: Option<S<CameraToml>>,
+    pub(super) render: Option<S<RenderToml>>,
+    #[serde(default)]
+    pub(super) materials: BTreeMap<String, S<MaterialToml>>,
+    #[serde(default)]
+    pub(super) spheres: Vec<S<SphereToml>>,
+    #[serde(default)]
+    pub(super) quads: Vec<S<QuadToml>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct CameraToml {
+    pub(super) eye: S<[Real; 3]>,
+    pub(super) target: S<[Real; 3]>,
+    pub(super) up: S<[Real; 3]>,
+    pub(super) vfov: S<Real>,
+    pub(super) aperture: Option<S<Real>>,
+    pub(super) focus_distance: Option<S<Real>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RenderToml {
+    pub(super) width: S<i64>,
+    pub(super) height: S<i64>,
+    pub(super) spp: S<i64>,
+    pub(super) max_bounces: S<i64>,
+    pub(super) background: Option<S<[Real; 3]>>,
+    pub(super) seed: Option<S<i64>>,
+    pub(super) light_sampling: Option<bool>,
+    pub(super) russian_roulette: Option<bool>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MaterialToml {
+    #[serde(rename = "type")]
+    pub(super) kind: S<String>,
+    pub(super) color: Option<S<[Real; 3]>>,
+    pub(super) emission: Option<S<[Real; 3]>>,
+    pub(super) strength: Option<S<Real>>,
+    pub(super) roughness: Option<S<Real>>,
+    pub(super) ior: Option<S<Real>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SphereToml {
+    pub(super) center: S<[Real; 3]>,
+    pub(super) radius: S<Real>,
+    pub(super) material: S<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct QuadToml {
+    pub(super) corner: S<[Real; 3]>,
+    pub(super) u: S<[Real; 3]>,
+    pub(super) v: S<[Real; 3]>,
+    pub(super) material: S<String>,
+}

@@ -1,0 +1,269 @@
+//! Scene files: TOML → validated [`Scene`] → the kernel's structs ([`KernelScene`]).
+//!
+//! Every error names the file, the line and column, and the field, so a user can fix it
+//! without reading code. The format is documented in README.md.
+
+//!
+//! The parts, in the order data flows: [`file`] is the TOML as written, [`validate`] turns it
+//! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
+
+mod file;
+mod kernel;
+mod validate;
+
+pub use kernel::KernelScene;
+
+use file::{line_column, SceneToml};
+use glam::Vec3;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// Largest image side, in pixels.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// Largest image, in pixels (2^23, e.g. 3840×2160 fits): the accumulation buffer holds 16 bytes
+/// per pixel and must fit one 128 MiB storage binding, the limit of lavapipe and many GPUs.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 23;
+/// Bound on `max_bounces`: paths this long carry no measurable energy, and the bound keeps a
+/// kernel loop from running for hours (lavapipe has no watchdog).
+pub const MAX_BOUNCES_LIMIT: u32 = 1024;
+/// Bound on samples per pixel, so every global sample index fits the kernel's u32 counter.
+pub const MAX_SPP: u32 = 1 << 30;
+/// Russian roulette starts after this many scattering events (when it is on).
+pub const ROULETTE_START_BOUNCE: u32 = 3;
+
+/// A bad scene: where, which field, and what is wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}", self.describe())]
+pub struct SceneError {
+    pub path: PathBuf,
+    /// 1-based line and column, where the problem has a place in the file.
+    pub position: Option<(usize, usize)>,
+    /// Dotted path of the field, e.g. `spheres[1].radius`.
+    pub field: Option<String>,
+    pub message: String,
+}
+
+impl SceneError {
+    fn describe(&self) -> String {
+        let mut out = self.path.display().to_string();
+        if let Some((line, col)) = self.position {
+            out += &format!(":{line}:{col}");
+        }
+        out += ": ";
+        if let Some(field) = &self.field {
+            out += &format!("{field}: ");
+        }
+        out + &self.message
+    }
+}
+
+/// A validated scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub name: String,
+    pub camera: Camera,
+    pub render: RenderSettings,
+    pub materials: Vec<Material>,
+    pub spheres: Vec<Sphere>,
+    pub quads: Vec<Quad>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub vfov: f32,
+    /// Lens diameter; 0 is a pinhole.
+    pub aperture: f32,
+    /// Distance to the plane in focus, along the view direction.
+    pub focus_distance: f32,
+}
+
+/// The camera's orthonormal basis, right-handed: `w` points from the target back at the eye,
+/// image-right is `up × w`, image-up is `w × right`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraBasis {
+    pub w: Vec3,
+    pub right: Vec3,
+    pub image_up: Vec3,
+}
+
+impl Camera {
+    pub fn basis(&self) -> CameraBasis {
+        let w = (self.eye - self.target).normalize();
+        let right = self.up.cross(w).normalize();
+        CameraBasis {
+            w,
+            right,
+            image_up: w.cross(right),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_bounces: u32,
+    pub background: Vec3,
+    pub seed: u32,
+    /// Next-event estimation with multiple importance sampling.
+    pub light_sampling: bool,
+    pub russian_roulette: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialKind {
+    Diffuse,
+    Specular,
+    /// GGX microfacet conductor; roughness in [0, 1], GGX alpha = roughness².
+    Metal {
+        roughness: f32,
+    },
+    /// Smooth glass-like interface with this index of refraction.
+    Dielectric {
+        ior: f32,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub kind: MaterialKind,
+    pub color: Vec3,
+    /// `emission * strength`.
+    pub emitted_radiance: Vec3,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: u32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quad {
+    pub corner: Vec3,
+    pub u: Vec3,
+    pub v: Vec3,
+    pub material: u32,
+}
+
+/// Command-line values that replace the scene's `[render]` ones.
+#[derive(Clone, Debug, Default)]
+pub struct RenderOverrides {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub spp: Option<u32>,
+    pub max_bounces: Option<u32>,
+    pub seed: Option<u32>,
+    pub light_sampling: Option<bool>,
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let bytes = std::fs::read(path).map_err(|e| SceneError {
+            path: path.to_owned(),
+            position: None,
+            field: None,
+            message: format!("cannot read the scene file: {e}"),
+        })?;
+        let text = String::from_utf8(bytes).map_err(|e| SceneError {
+            path: path.to_owned(),
+            position: None,
+            field: None,
+            message: format!(
+                "not a TOML scene: the file is not UTF-8 text (invalid byte at offset {})",
+                e.utf8_error().valid_up_to()
+            ),
+        })?;
+        Scene::parse(&text, path)
+    }
+
+    /// Parses and validates scene text; `path` is only used in messages and for the name.
+    pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+        let at = |span: Option<Range<usize>>, field: Option<String>, message: String| SceneError {
+            path: path.to_owned(),
+            position: span.map(|s| line_column(text, s.start)),
+            field,
+            message,
+        };
+        if text.trim().is_empty() {
+            return Err(at(
+                None,
+                None,
+                "the file is empty: a scene needs at least [camera], [render] and one object"
+                    .into(),
+            ));
+        }
+        if text.contains('\0') {
+            return Err(at(
+                None,
+                None,
+                "not a TOML scene: the file contains NUL bytes (binary data?)".into(),
+            ));
+        }
+        let raw: SceneToml = toml::from_str(text).map_err(|e| {
+            at(
+                e.span(),
+                None,
+                format!("TOML error: {}", e.message().trim_end()),
+            )
+        })?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scene".into());
+        raw.validate(name)
+            .map_err(|e| at(e.span, Some(e.field), e.message))
+    }
+
+    /// Applies command-line overrides and checks the result as the scene's own values are checked.
+    pub fn with_overrides(mut self, o: &RenderOverrides) -> Result<Scene, String> {
+        let r = &mut self.render;
+        r.width = o.width.unwrap_or(r.width);
+        r.height = o.height.unwrap_or(r.height);
+        r.spp = o.spp.unwrap_or(r.spp);
+        r.max_bounces = o.max_bounces.unwrap_or(r.max_bounces);
+        r.seed = o.seed.unwrap_or(r.seed);
+        r.light_sampling = o.light_sampling.unwrap_or(r.light_sampling);
+        check_image_size(r.width as i64, r.height as i64)?;
+        check_range(r.spp as i64, 1, MAX_SPP as i64).map_err(|m| format!("spp {m}"))?;
+        check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)
+            .map_err(|m| format!("max_bounces {m}"))?;
+        Ok(self)
+    }
+}
+
+pub(crate) fn check_range(value: i64, min: i64, max: i64) -> Result<(), String> {
+    if value < min || value > max {
+        return Err(format!("must be in {min}..={max}, got {value}"));
+    }
+    Ok(())
+}
+
+pub(crate) fn check_image_size(width: i64, height: i64) -> Result<(), String> {
+    for (name, side) in [("width", width), ("height", height)] {
+        if side < 1 {
+            return Err(format!("{name} must be at least 1, got {side}"));
+        }
+        if side > MAX_IMAGE_SIDE as i64 {
+            return Err(format!(
+                "{name} {side} is too large: at most {MAX_IMAGE_SIDE} pixels a side"
+            ));
+        }
+    }
+    let pixels = width * height;
+    if pixels as u64 > MAX_IMAGE_PIXELS {
+        return Err(format!(
+            "{width}×{height} = {pixels} pixels is too large to hold: at most {MAX_IMAGE_PIXELS} \
+             pixels (e.g. 3840×2160), so the accumulation buffer fits one 128 MiB GPU binding"
+        ));
+    }
+    Ok(())
+}

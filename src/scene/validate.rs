@@ -1,0 +1,386 @@
+//! From the file as written to a validated [`Scene`]: every range, reference and degenerate
+//! case checked, each failure tied to its field and its place in the file.
+
+use super::file::{Real, SceneToml, S};
+use super::{
+    check_image_size, check_range, Camera, Material, MaterialKind, Quad, RenderSettings, Scene,
+    Sphere, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
+use glam::Vec3;
+use std::collections::BTreeMap;
+use std::ops::Range;
+
+/// A validation failure before it is given the file name and a line.
+pub(super) struct FieldError {
+    pub(super) span: Option<Range<usize>>,
+    pub(super) field: String,
+    pub(super) message: String,
+}
+
+fn fail<T>(
+    span: Range<usize>,
+    field: impl Into<String>,
+    message: impl Into<String>,
+) -> Result<T, FieldError> {
+    Err(FieldError {
+        span: Some(span),
+        field: field.into(),
+        message: message.into(),
+    })
+}
+
+fn real(x: &S<Real>, field: &str) -> Result<f32, FieldError> {
+    let v = x.get_ref().0;
+    if !v.is_finite() {
+        return fail(x.span(), field, format!("must be a finite number, got {v}"));
+    }
+    if v.abs() > f32::MAX as f64 {
+        return fail(x.span(), field, format!("{v} does not fit a 32-bit float"));
+    }
+    Ok(v as f32)
+}
+
+fn vec3(x: &S<[Real; 3]>, field: &str) -> Result<Vec3, FieldError> {
+    let mut out = [0.0f32; 3];
+    for (o, r) in out.iter_mut().zip(x.get_ref()) {
+        if !r.0.is_finite() || r.0.abs() > f32::MAX as f64 {
+            return fail(
+                x.span(),
+                field,
+                format!(
+                    "every component must be a finite 32-bit number, got {}",
+                    r.0
+                ),
+            );
+        }
+        *o = r.0 as f32;
+    }
+    Ok(Vec3::from(out))
+}
+
+fn non_negative(x: &S<[Real; 3]>, field: &str) -> Result<Vec3, FieldError> {
+    let v = vec3(x, field)?;
+    if v.min_element() < 0.0 {
+        return fail(x.span(), field, format!("components must be ≥ 0, got {v}"));
+    }
+    Ok(v)
+}
+
+fn int_in(x: &S<i64>, field: &str, min: i64, max: i64) -> Result<u32, FieldError> {
+    check_range(*x.get_ref(), min, max)
+        .map(|_| *x.get_ref() as u32)
+        .or_else(|m| fail(x.span(), field, m))
+}
+
+impl SceneToml {
+    pub(super) fn validate(self, name: String) -> Result<Scene, FieldError> {
+        let whole = |field: &str, message: String| FieldError {
+            span: None,
+            field: field.into(),
+            message,
+        };
+        let camera = self.camera.ok_or_else(|| {
+            whole(
+                "[camera]",
+                "missing: the scene needs a [camera] table".into(),
+            )
+        })?;
+        let camera = camera.into_inner();
+        let render = self.render.ok_or_else(|| {
+            whole(
+                "[render]",
+                "missing: the scene needs a [render] table".into(),
+            )
+        })?;
+        let render_span = render.span();
+        let render = render.into_inner();
+
+        let eye = vec3(&camera.eye, "camera.eye")?;
+        let target = vec3(&camera.target, "camera.target")?;
+        let up = vec3(&camera.up, "camera.up")?;
+        let vfov = real(&camera.vfov, "camera.vfov")?;
+        if !(vfov > 0.0 && vfov < 180.0) {
+            return fail(
+                camera.vfov.span(),
+                "camera.vfov",
+                format!("must be in (0, 180) degrees, got {vfov}"),
+            );
+        }
+        let view = target - eye;
+        if view.length() == 0.0 || !view.length().is_finite() {
+            return fail(
+                camera.target.span(),
+                "camera.target",
+                "must differ from camera.eye (the view direction is target − eye)",
+            );
+        }
+        if up.cross(view).length() <= 1e-6 * up.length() * view.length() {
+            return fail(
+                camera.up.span(),
+                "camera.up",
+                format!(
+                    "must not be zero or parallel to the view direction {}",
+                    view.normalize()
+                ),
+            );
+        }
+        let aperture = match &camera.aperture {
+            Some(a) => {
+                let v = real(a, "camera.aperture")?;
+                if v < 0.0 {
+                    return fail(
+                        a.span(),
+                        "camera.aperture",
+                        format!("the lens diameter must be ≥ 0, got {v}"),
+                    );
+                }
+                v
+            }
+            None => 0.0,
+        };
+        let focus_distance = match &camera.focus_distance {
+            Some(f) => {
+                let v = real(f, "camera.focus_distance")?;
+                if v <= 0.0 {
+                    return fail(
+                        f.span(),
+                        "camera.focus_distance",
+                        format!("must be > 0, got {v}"),
+                    );
+                }
+                v
+            }
+            None => view.length(),
+        };
+
+        let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
+        check_image_size(width, height).or_else(|m| {
+            let span = if width < 1 || width > MAX_IMAGE_SIDE as i64 {
+                render.width.span()
+            } else if height < 1 || height > MAX_IMAGE_SIDE as i64 {
+                render.height.span()
+            } else {
+                render_span.clone()
+            };
+            fail(span, "render", m)
+        })?;
+        let spp = int_in(&render.spp, "render.spp", 1, MAX_SPP as i64)?;
+        let max_bounces = int_in(
+            &render.max_bounces,
+            "render.max_bounces",
+            0,
+            MAX_BOUNCES_LIMIT as i64,
+        )?;
+        let background = match &render.background {
+            Some(b) => non_negative(b, "render.background")?,
+            None => Vec3::ZERO,
+        };
+        let seed = match &render.seed {
+            Some(s) => int_in(s, "render.seed", 0, u32::MAX as i64)?,
+            None => 0,
+        };
+
+        let mut materials = Vec::new();
+        let mut index_of = BTreeMap::new();
+        for (name, m) in &self.materials {
+            let m = m.get_ref();
+            let field = |f: &str| format!("materials.{name}.{f}");
+            let positive =
+                |x: &Option<S<Real>>, name: &str, what: &str| -> Result<f32, FieldError> {
+                    let Some(x) = x else {
+                        return fail(
+                            m.kind.span(),
+                            field(name),
+                            format!("missing: a {what} needs {name}"),
+                        );
+                    };
+                    real(x, &field(name))
+                };
+            let kind = match m.kind.get_ref().as_str() {
+                "diffuse" => MaterialKind::Diffuse,
+                "specular" => MaterialKind::Specular,
+                "metal" => {
+                    let roughness = positive(&m.roughness, "roughness", "metal")?;
+                    if !(0.0..=1.0).contains(&roughness) {
+                        return fail(
+                            m.roughness.as_ref().unwrap().span(),
+                            field("roughness"),
+                            format!("must be in [0, 1] (0 = mirror), got {roughness}"),
+                        );
+                    }
+                    MaterialKind::Metal { roughness }
+                }
+                "dielectric" => {
+                    let ior = positive(&m.ior, "ior", "dielectric")?;
+                    if ior <= 0.0 {
+                        return fail(
+                            m.ior.as_ref().unwrap().span(),
+                            field("ior"),
+                            format!("the index of refraction must be > 0, got {ior}"),
+                        );
+                    }
+                    MaterialKind::Dielectric { ior }
+                }
+                other => {
+                    return fail(
+                        m.kind.span(),
+                        field("type"),
+                        format!(
+                            "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\""
+                        ),
+                    )
+                }
+            };
+            // A field that does not apply is most likely a mistake: say so.
+            for (value, name, applies) in [
+                (
+                    &m.roughness,
+                    "roughness",
+                    matches!(kind, MaterialKind::Metal { .. }),
+                ),
+                (
+                    &m.ior,
+                    "ior",
+                    matches!(kind, MaterialKind::Dielectric { .. }),
+                ),
+            ] {
+                if let (Some(v), false) = (value, applies) {
+                    return fail(
+                        v.span(),
+                        field(name),
+                        format!("{name} does not apply to a {} material", m.kind.get_ref()),
+                    );
+                }
+            }
+            let color = match (&m.color, kind) {
+                (Some(c), _) => {
+                    let color = non_negative(c, &field("color"))?;
+                    if color.max_element() > 1.0 {
+                        return fail(
+                            c.span(),
+                            field("color"),
+                            format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
+                        );
+                    }
+                    color
+                }
+                // Clear glass unless tinted.
+                (None, MaterialKind::Dielectric { .. }) => Vec3::ONE,
+                (None, _) => {
+                    return fail(
+                        m.kind.span(),
+                        field("color"),
+                        "missing: this material needs a color",
+                    );
+                }
+            };
+            let emission = match &m.emission {
+                Some(e) => non_negative(e, &field("emission"))?,
+                None => Vec3::ZERO,
+            };
+            let strength = match &m.strength {
+                Some(s) => {
+                    let v = real(s, &field("strength"))?;
+                    if v < 0.0 {
+                        return fail(s.span(), field("strength"), format!("must be ≥ 0, got {v}"));
+                    }
+                    v
+                }
+                None => 1.0,
+            };
+            index_of.insert(name.clone(), materials.len() as u32);
+            materials.push(Material {
+                name: name.clone(),
+                kind,
+                color,
+                emitted_radiance: emission * strength,
+            });
+        }
+        let material_ref = |m: &S<String>, field: String| -> Result<u32, FieldError> {
+            index_of.get(m.get_ref()).copied().ok_or_else(|| {
+                let known: Vec<_> = index_of.keys().map(|k| format!("{k:?}")).collect();
+                FieldError {
+                    span: Some(m.span()),
+                    field,
+                    message: format!(
+                        "unknown material {:?}; defined materials: {}",
+                        m.get_ref(),
+                        if known.is_empty() {
+                            "none".into()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                }
+            })
+        };
+
+        let mut spheres = Vec::new();
+        for (i, s) in self.spheres.iter().enumerate() {
+            let s = s.get_ref();
+            let field = |f: &str| format!("spheres[{i}].{f}");
+            let center = vec3(&s.center, &field("center"))?;
+            let radius = real(&s.radius, &field("radius"))?;
+            if radius <= 0.0 {
+                return fail(
+                    s.radius.span(),
+                    field("radius"),
+                    format!("must be > 0, got {radius}"),
+                );
+            }
+            let material = material_ref(&s.material, field("material"))?;
+            spheres.push(Sphere {
+                center,
+                radius,
+                material,
+            });
+        }
+        let mut quads = Vec::new();
+        for (i, q) in self.quads.iter().enumerate() {
+            let q = q.get_ref();
+            let field = |f: &str| format!("quads[{i}].{f}");
+            let corner = vec3(&q.corner, &field("corner"))?;
+            let u = vec3(&q.u, &field("u"))?;
+            let v = vec3(&q.v, &field("v"))?;
+            let area = u.cross(v).length();
+            if !area.is_finite() || area <= 1e-6 * u.length() * v.length() {
+                return fail(
+                    q.v.span(),
+                    field("v"),
+                    format!("degenerate quad: edges u = {u} and v = {v} are parallel or zero"),
+                );
+            }
+            let material = material_ref(&q.material, field("material"))?;
+            quads.push(Quad {
+                corner,
+                u,
+                v,
+                material,
+            });
+        }
+        Ok(Scene {
+            name,
+            camera: Camera {
+                eye,
+                target,
+                up,
+                vfov,
+                aperture,
+                focus_distance,
+            },
+            render: RenderSettings {
+                width: width as u32,
+                height: height as u32,
+                spp,
+                max_bounces,
+                background,
+                seed,
+                light_sampling: render.light_sampling.unwrap_or(true),
+                russian_roulette: render.russian_roulette.unwrap_or(true),
+            },
+            materials,
+            spheres,
+            quads,
+        })
+    }
+}
