@@ -7,12 +7,16 @@ struct Hit {
     // The hit point; on spheres projected back onto the surface, so errors cannot build up
     // over many bounces.
     position: vec3<f32>,
-    // Geometric normal, unit length, facing against the incoming ray.
+    // Geometric normal, unit length, facing against the incoming ray. It alone decides which
+    // side of the surface a ray is on (offsets, entering or leaving glass).
     normal: vec3<f32>,
+    // The normal to shade with, on the geometric normal's side: interpolated vertex normals on
+    // smooth triangles, the geometric normal elsewhere.
+    shading_normal: vec3<f32>,
     material: u32,
     // True when the ray hit the side the surface's outward normal points to.
     front_face: bool,
-    // Which primitive: PRIMITIVE_SPHERE or PRIMITIVE_QUAD, and its index.
+    // Which primitive: PRIMITIVE_SPHERE, PRIMITIVE_QUAD or PRIMITIVE_TRIANGLE, and its index.
     primitive: u32,
     index: u32,
 }
@@ -73,6 +77,9 @@ struct ClosestPrimitive {
 }
 
 fn closest_primitive(ray: Ray) -> ClosestPrimitive {
+    if USE_BVH {
+        return bvh_closest_primitive(ray);
+    }
     var best = ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
     for (var i = 0u; i < sphere_count(); i++) {
         let t = hit_sphere(spheres[i], ray);
@@ -86,11 +93,23 @@ fn closest_primitive(ray: Ray) -> ClosestPrimitive {
             best = ClosestPrimitive(t, PRIMITIVE_QUAD, i);
         }
     }
+    if HAS_TRIANGLES && triangle_count() > 0u {
+        let r = triangle_ray(ray);
+        for (var i = 0u; i < triangle_count(); i++) {
+            let t = hit_triangle(triangles[i], r);
+            if t < best.t {
+                best = ClosestPrimitive(t, PRIMITIVE_TRIANGLE, i);
+            }
+        }
+    }
     return best;
 }
 
 // Whether the first thing `ray` meets is the primitive (primitive, index).
 fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
+    if USE_BVH {
+        return bvh_first_hit_is(ray, primitive, index);
+    }
     let closest = closest_primitive(ray);
     return closest.t != NO_HIT && closest.primitive == primitive && closest.index == index;
 }
@@ -105,6 +124,8 @@ fn intersect_scene(ray: Ray) -> Hit {
     hit.primitive = closest.primitive;
     hit.index = closest.index;
     var outward: vec3<f32>;
+    // Zero: shade with the geometric normal.
+    var shading = vec3<f32>(0.0);
     if closest.primitive == PRIMITIVE_SPHERE {
         let s = spheres[closest.index];
         // Normalised, not divided by the radius: a normal a little too long would make
@@ -112,6 +133,17 @@ fn intersect_scene(ray: Ray) -> Hit {
         outward = normalize(ray.origin + closest.t * ray.dir - s.center);
         hit.position = s.center + s.radius * outward;
         hit.material = s.material;
+    } else if HAS_TRIANGLES && closest.primitive == PRIMITIVE_TRIANGLE {
+        let tri = triangles[closest.index];
+        let b = triangle_barycentrics(tri, triangle_ray(ray));
+        outward = triangle_normal(tri);
+        // On the triangle's plane, from its own vertices, as spheres are projected.
+        hit.position = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
+        hit.material = tri.material;
+        let n = triangle_normals[closest.index];
+        if n.smooth_shading != 0u {
+            shading = normalize(b.x * n.n0 + b.y * n.n1 + b.z * n.n2);
+        }
     } else {
         outward = quads[closest.index].normal;
         hit.position = ray.origin + closest.t * ray.dir;
@@ -119,7 +151,18 @@ fn intersect_scene(ray: Ray) -> Hit {
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;
     hit.normal = select(-outward, outward, hit.front_face);
+    hit.shading_normal = hit.normal;
+    if HAS_TRIANGLES && any(shading != vec3<f32>(0.0)) {
+        hit.shading_normal = select(-shading, shading, dot(shading, hit.normal) >= 0.0);
+    }
     return hit;
+}
+
+// Whether `dir` is on one side of the surface by the shading normal and on the other by the
+// geometric normal: following it would leak light through a smooth-shaded surface, so such
+// directions carry nothing. Never true where the shading normal is the geometric one.
+fn crosses_shading_side(dir: vec3<f32>, hit: Hit) -> bool {
+    return HAS_TRIANGLES && dot(dir, hit.normal) * dot(dir, hit.shading_normal) < 0.0;
 }
 
 // Moves a surface point off the surface along n, by a few ulps of its own magnitude, so the

@@ -1,5 +1,5 @@
 // Light sampling for next-event estimation (mirror: src/cpu/lights.rs). An emitter is chosen
-// in proportion to its power, then a direction towards it: quads by area, spheres by the cone
+// in proportion to its power, then a direction towards it: quads and triangles by area, spheres by the cone
 // of directions they subtend from outside, and by area from inside (where there is no cone).
 // All pdfs are per unit solid angle at the shading point and include the selection probability.
 
@@ -22,7 +22,19 @@ fn pick_emitter(u: f32) -> u32 {
     return emitter_count() - 1u;
 }
 
-// Whether an emitter is a quad; known at compile time when the scene's emitters are all quads
+// Whether an emitter is a triangle; known at compile time when the scene has no triangle
+// emitters, or only those.
+fn emitter_is_triangle(primitive: u32) -> bool {
+    if !HAS_TRIANGLE_EMITTERS {
+        return false;
+    }
+    if !HAS_SPHERE_EMITTERS && !HAS_QUAD_EMITTERS {
+        return true;
+    }
+    return primitive == PRIMITIVE_TRIANGLE;
+}
+
+// Whether an emitter that is not a triangle is a quad; known at compile time when the scene's emitters are all quads
 // or all spheres, and then the other kind's code is compiled out (see src/shader.rs).
 fn emitter_is_quad(primitive: u32) -> bool {
     if !HAS_SPHERE_EMITTERS {
@@ -83,6 +95,19 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     out.primitive = e.primitive;
     out.index = e.index;
+    if emitter_is_triangle(e.primitive) {
+        // Uniform on the triangle's area.
+        let tri = triangles[e.index];
+        let to_light = triangle_point(tri, u) - p;
+        let t = length(to_light);
+        if t <= 0.0 {
+            return out;
+        }
+        out.dir = to_light / t;
+        out.pdf = e.probability * area_to_solid_angle(t, dot(triangle_normal(tri), out.dir), tri.area);
+        out.radiance = materials[tri.material].emission;
+        return out;
+    }
     if emitter_is_quad(e.primitive) {
         let q = quads[e.index];
         let to_light = q.corner + u.x * q.edge_u + u.y * q.edge_v - p;
@@ -129,6 +154,15 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
 // The pdf with which sample_light(p, probe) would have produced `dir`, a direction that meets
 // the emitting primitive (primitive, index).
 fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, index: u32) -> f32 {
+    if emitter_is_triangle(primitive) {
+        let tri = triangles[index];
+        let normal = triangle_normal(tri);
+        let t = triangle_plane_distance(tri, normal, p, dir);
+        if !(t > 0.0) {
+            return 0.0;
+        }
+        return tri.light_probability * area_to_solid_angle(t, dot(normal, dir), tri.area);
+    }
     if emitter_is_quad(primitive) {
         let q = quads[index];
         let cos_light = dot(q.normal, dir);

@@ -5,6 +5,10 @@
 @group(0) @binding(2) var<storage, read> quads: array<Quad>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(6) var<storage, read> emitters: array<Emitter>;
+@group(0) @binding(8) var<storage, read> triangles: array<Triangle>;
+@group(0) @binding(9) var<storage, read> triangle_normals: array<TriangleNormals>;
+@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(13) var<storage, read> bvh_primitives: array<u32>;
 
 fn sphere_count() -> u32 {
     return params.sphere_count;
@@ -16,4 +20,8 @@ fn quad_count() -> u32 {
 
 fn emitter_count() -> u32 {
     return params.emitter_count;
+}
+
+fn triangle_count() -> u32 {
+    return params.triangle_count;
 }

@@ -9,6 +9,12 @@
 @group(0) @binding(2) var<uniform> quads: array<Quad, max(QUAD_COUNT, 1u)>;
 @group(0) @binding(3) var<uniform> materials: array<Material, max(MATERIAL_COUNT, 1u)>;
 @group(0) @binding(6) var<uniform> emitters: array<Emitter, max(EMITTER_COUNT, 1u)>;
+// Meshes always go through storage buffers (and the BVH): the uniform layout is for scenes
+// without triangles, where these hold one unused element.
+@group(0) @binding(8) var<storage, read> triangles: array<Triangle>;
+@group(0) @binding(9) var<storage, read> triangle_normals: array<TriangleNormals>;
+@group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(13) var<storage, read> bvh_primitives: array<u32>;
 
 fn sphere_count() -> u32 {
     return SPHERE_COUNT;
@@ -20,4 +26,8 @@ fn quad_count() -> u32 {
 
 fn emitter_count() -> u32 {
     return EMITTER_COUNT;
+}
+
+fn triangle_count() -> u32 {
+    return 0u;
 }

@@ -58,21 +58,21 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         // Next-event estimation: light arriving after one more scattering event.
         var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
         let light = sample_light(p, origin, &light_rng);
-        if light.pdf > 0.0 {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
+        if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal);
             if any(f_cos > vec3<f32>(0.0)) {
                 segments += 1u;
                 if first_hit_is(Ray(origin, light.dir), light.primitive, light.index) {
-                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     (*path).radiance += (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
                 }
             }
         }
     }
     var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
-    let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &bsdf_rng);
+    let s = bsdf_sample(m, wo, hit.shading_normal, hit.front_face, &bsdf_rng);
     var throughput = (*path).throughput * s.weight;
-    if all(throughput == vec3<f32>(0.0)) {
+    if all(throughput == vec3<f32>(0.0)) || crosses_shading_side(s.dir, hit) {
         return true;
     }
     if bounce >= params.roulette_start {

@@ -29,7 +29,7 @@ struct Params {
     emitter_count: u32,
     // Russian roulette after the scattering at this bounce and later ones (0xffffffff: off).
     roulette_start: u32,
-    pad0: u32,
+    triangle_count: u32,
     pad1: u32,
 }
 
@@ -77,6 +77,41 @@ struct Material {
 
 const PRIMITIVE_SPHERE: u32 = 0u;
 const PRIMITIVE_QUAD: u32 = 1u;
+const PRIMITIVE_TRIANGLE: u32 = 2u;
+
+// A mesh triangle: what intersection and light sampling read. Its unit normal is
+// normalize(cross(v1 - v0, v2 - v0)).
+struct Triangle {
+    v0: vec3<f32>,
+    material: u32,
+    v1: vec3<f32>,
+    // Probability that light sampling picks this triangle (0 when it does not emit).
+    light_probability: f32,
+    v2: vec3<f32>,
+    area: f32,
+}
+
+// A triangle's vertex normals, read only at the closest hit, for shading.
+struct TriangleNormals {
+    n0: vec3<f32>,
+    // 1: interpolate the vertex normals; 0: flat (the geometric normal shades).
+    smooth_shading: u32,
+    n1: vec3<f32>,
+    n2: vec3<f32>,
+}
+
+// A node of the flattened BVH (src/scene/bvh.rs). An inner node (count == 0) has its children at
+// first and first + 1; a leaf holds bvh_primitives[first .. first + count].
+struct BvhNode {
+    min: vec3<f32>,
+    first: u32,
+    max: vec3<f32>,
+    count: u32,
+}
+
+// A BVH leaf's primitive reference: the kind in the top two bits, the index below.
+const PRIMITIVE_KIND_SHIFT: u32 = 30u;
+const PRIMITIVE_INDEX_MASK: u32 = 0x3fffffffu;
 
 // One entry per emitting primitive, for choosing one in proportion to its power.
 struct Emitter {

@@ -3,16 +3,18 @@
 use crate::scene::KernelScene;
 use crate::shader_types::{
     Emitter, Material, Quad, Sphere, MATERIAL_DIELECTRIC, MATERIAL_METAL, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 7] = [
+pub const SHADER_PARTS: [(&str, &str); 9] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
+    ("triangle.wgsl", include_str!("../shaders/triangle.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
+    ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("trace.wgsl", include_str!("../shaders/trace.wgsl")),
@@ -35,6 +37,9 @@ pub enum SceneBinding {
     /// Uniform buffers sized for one scene, with the counts compiled in
     /// (`shaders/scene_uniform.wgsl`): 1.2–2.3× faster on lavapipe, for scenes that fit.
     Uniform(SceneCounts),
+    /// Storage buffers traversed through the scene's BVH (`shaders/bvh.wgsl`): scenes with
+    /// meshes or many objects, which [`KernelScene::bvh_nodes`] then holds.
+    Bvh,
 }
 
 /// How many of each object a scene has.
@@ -80,6 +85,9 @@ impl SceneBinding {
     /// The fast uniform binding when every array fits in `max_uniform_binding` bytes (the
     /// device's limit) and in [`MAX_UNIFORM_SCENE_BYTES`], storage buffers otherwise.
     pub fn for_scene(scene: &KernelScene, max_uniform_binding: u64) -> SceneBinding {
+        if !scene.bvh_nodes.is_empty() {
+            return SceneBinding::Bvh;
+        }
         let counts = SceneCounts::of(scene);
         if counts.largest_uniform_buffer() <= max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES) {
             SceneBinding::Uniform(counts)
@@ -93,18 +101,27 @@ impl SceneBinding {
         match self {
             SceneBinding::Storage => "storage",
             SceneBinding::Uniform(_) => "uniform",
+            SceneBinding::Bvh => "bvh",
         }
     }
 
     /// The WGSL declaring the scene's bindings, as a named part.
     fn part(&self) -> (&'static str, String) {
+        // Triangles exist only in the storage layouts; the uniform one compiles their code out.
+        let storage = |bvh: bool| {
+            format!(
+                "const USE_BVH: bool = {bvh};\nconst HAS_TRIANGLES: bool = true;\n{SCENE_STORAGE}"
+            )
+        };
         match self {
-            SceneBinding::Storage => ("scene_storage.wgsl", SCENE_STORAGE.to_string()),
+            SceneBinding::Storage => ("scene_storage.wgsl", storage(false)),
+            SceneBinding::Bvh => ("scene_storage.wgsl", storage(true)),
             SceneBinding::Uniform(c) => (
                 "scene_uniform.wgsl",
                 format!(
                     "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
-                     const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n{}",
+                     const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
+                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n{}",
                     c.spheres, c.quads, c.materials, c.emitters, SCENE_UNIFORM
                 ),
             ),
@@ -124,6 +141,7 @@ pub struct KernelFeatures {
     pub light_sampling: bool,
     pub sphere_emitters: bool,
     pub quad_emitters: bool,
+    pub triangle_emitters: bool,
     pub metal: bool,
     pub dielectric: bool,
 }
@@ -134,6 +152,7 @@ impl KernelFeatures {
         light_sampling: true,
         sphere_emitters: true,
         quad_emitters: true,
+        triangle_emitters: true,
         metal: true,
         dielectric: true,
     };
@@ -146,6 +165,7 @@ impl KernelFeatures {
             light_sampling: scene.params.light_sampling != 0 && !scene.emitters.is_empty(),
             sphere_emitters: emits(PRIMITIVE_SPHERE),
             quad_emitters: emits(PRIMITIVE_QUAD),
+            triangle_emitters: emits(PRIMITIVE_TRIANGLE),
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
         }
@@ -157,6 +177,7 @@ impl KernelFeatures {
         needs(self.light_sampling, other.light_sampling)
             && needs(self.sphere_emitters, other.sphere_emitters)
             && needs(self.quad_emitters, other.quad_emitters)
+            && needs(self.triangle_emitters, other.triangle_emitters)
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
     }
@@ -165,11 +186,12 @@ impl KernelFeatures {
     fn part(&self) -> String {
         format!(
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
-             const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_METAL: bool = {};\n\
-             const HAS_DIELECTRIC: bool = {};\n",
+             const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
+             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
+            self.triangle_emitters,
             self.metal,
             self.dielectric
         )

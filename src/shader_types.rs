@@ -33,7 +33,7 @@ pub struct Params {
     pub emitter_count: u32,
     /// Russian roulette after the scattering at this bounce and later ones (`ROULETTE_OFF`: off).
     pub roulette_start: u32,
-    pub pad0: u32,
+    pub triangle_count: u32,
     pub pad1: u32,
 }
 
@@ -104,3 +104,47 @@ pub struct Emitter {
     pub cdf: f32,
     pub probability: f32,
 }
+
+pub const PRIMITIVE_TRIANGLE: u32 = 2;
+
+/// A mesh triangle: what intersection and light sampling read (48 bytes, so a BVH leaf's
+/// triangles stay compact). Its unit normal is `normalize((v1 − v0) × (v2 − v0))`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Triangle {
+    pub v0: [f32; 3],
+    pub material: u32,
+    pub v1: [f32; 3],
+    /// Probability that light sampling picks this triangle (0 when it does not emit).
+    pub light_probability: f32,
+    pub v2: [f32; 3],
+    pub area: f32,
+}
+
+/// A triangle's vertex normals, read only at the closest hit, for shading.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TriangleNormals {
+    pub n0: [f32; 3],
+    /// 1: interpolate the vertex normals; 0: flat (the geometric normal shades).
+    pub smooth_shading: u32,
+    pub n1: [f32; 3],
+    pub _pad1: u32,
+    pub n2: [f32; 3],
+    pub _pad2: u32,
+}
+
+/// A node of the flattened BVH. An inner node (`count == 0`) has its children at `first` and
+/// `first + 1`; a leaf holds `bvh_primitives[first .. first + count]`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BvhNode {
+    pub min: [f32; 3],
+    pub first: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+/// A BVH leaf's primitive reference: the kind in the top two bits, the index below.
+pub const PRIMITIVE_KIND_SHIFT: u32 = 30;
+pub const PRIMITIVE_INDEX_MASK: u32 = (1 << PRIMITIVE_KIND_SHIFT) - 1;

@@ -206,7 +206,20 @@ fn reference_light_pdf(scene: &glint::scene::Scene, p: glam::DVec3, dir: glam::D
         .iter()
         .map(|q| power(q.material) * q.u.cross(q.v).length() as f64)
         .collect();
-    let total: f64 = sphere_power.iter().chain(&quad_power).sum();
+    let triangle_area = |t: &glint::scene::Triangle| {
+        let [a, b, c] = t.vertices.map(|v| v.as_dvec3());
+        0.5 * (b - a).cross(c - a).length()
+    };
+    let triangle_power: Vec<f64> = scene
+        .triangles
+        .iter()
+        .map(|t| power(t.material) * triangle_area(t))
+        .collect();
+    let total: f64 = sphere_power
+        .iter()
+        .chain(&quad_power)
+        .chain(&triangle_power)
+        .sum();
     let mut pdf = 0.0;
     for (s, w) in scene.spheres.iter().zip(&sphere_power) {
         let (c, r) = (s.center.as_dvec3(), s.radius as f64);
@@ -236,10 +249,60 @@ fn reference_light_pdf(scene: &glint::scene::Scene, p: glam::DVec3, dir: glam::D
             }
         }
     }
+    for (tri, w) in scene.triangles.iter().zip(&triangle_power) {
+        let [a, b, c] = tri.vertices.map(|v| v.as_dvec3());
+        let n: DVec3 = (b - a).cross(c - a).normalize();
+        let t = n.dot(a - p) / n.dot(dir);
+        if t > 0.0 {
+            // Inside when the three sub-triangles' signed areas agree with the triangle's.
+            let x = p + t * dir;
+            let inside = [(a, b), (b, c), (c, a)]
+                .iter()
+                .all(|&(e0, e1)| (e1 - e0).cross(x - e0).dot(n) >= 0.0);
+            if inside {
+                pdf += w / total * t * t / (n.dot(dir).abs() * triangle_area(tri));
+            }
+        }
+    }
     pdf
 }
 
-fn light_cases() -> [(&'static str, glint::scene::Scene, Vec3); 2] {
+/// TWO_LIGHTS with an emitting triangle mesh added (an open pyramid of four triangles, two
+/// materials), so light sampling chooses among spheres, quads and triangles by power.
+fn lights_with_triangles() -> glint::scene::Scene {
+    let mut scene = common::scene(&format!(
+        "{SCENE_HEADER}{TWO_LIGHTS}
+[materials.tri_lamp]
+type = \"diffuse\"
+color = [0.0, 0.0, 0.0]
+emission = [0.5, 1.0, 2.0]
+strength = 3.0
+[materials.tri_lamp_dim]
+type = \"diffuse\"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 1.0, 1.0]
+"
+    ));
+    let index = |name: &str| scene.materials.iter().position(|m| m.name == name).unwrap() as u32;
+    let (bright, dim) = (index("tri_lamp"), index("tri_lamp_dim"));
+    let apex = Vec3::new(-1.2, -0.5, 1.8);
+    let base = [
+        Vec3::new(-2.0, -1.5, 1.0),
+        Vec3::new(-0.5, -1.5, 1.2),
+        Vec3::new(-0.8, -1.0, 2.6),
+        Vec3::new(-2.2, -0.8, 2.4),
+    ];
+    for k in 0..4 {
+        scene.triangles.push(glint::scene::Triangle {
+            vertices: [base[k], base[(k + 1) % 4], apex],
+            normals: None,
+            material: if k % 2 == 0 { bright } else { dim },
+        });
+    }
+    scene
+}
+
+fn light_cases() -> [(&'static str, glint::scene::Scene, Vec3); 3] {
     [
         (
             "two lights",
@@ -250,6 +313,11 @@ fn light_cases() -> [(&'static str, glint::scene::Scene, Vec3); 2] {
             "inside a light",
             common::scene(&format!("{SCENE_HEADER}{INSIDE_LIGHT}")),
             Vec3::new(0.6, -0.4, 0.3),
+        ),
+        (
+            "spheres, quads and triangles",
+            lights_with_triangles(),
+            Vec3::ZERO,
         ),
     ]
 }
@@ -279,13 +347,7 @@ fn check_light_samples(name: &str, scene: &glint::scene::Scene, p: Vec3, samples
 fn cpu_light_sampling() {
     for (k, (name, scene, p)) in light_cases().into_iter().enumerate() {
         let kernel = scene.kernel_scene();
-        let refs = glint::cpu::trace::SceneRefs {
-            params: &kernel.params,
-            spheres: &kernel.spheres,
-            quads: &kernel.quads,
-            materials: &kernel.materials,
-            emitters: &kernel.emitters,
-        };
+        let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 21 + k as u32);

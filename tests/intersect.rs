@@ -3,7 +3,7 @@
 use glam::Vec3;
 use glint::cpu::intersect::{
     closest_primitive, first_hit_is, hit_quad, hit_sphere, intersect_scene, offset_ray_origin,
-    NO_HIT,
+    Geometry, NO_HIT,
 };
 use glint::cpu::Ray;
 use glint::scene::{Material, MaterialKind, Quad as SceneQuad, Scene};
@@ -59,6 +59,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             v: v.into(),
             material: 0,
         }],
+        triangles: vec![],
     };
     scene.kernel_scene().quads[0]
 }
@@ -164,16 +165,23 @@ fn nearest_hit_wins_and_the_normal_faces_the_ray() {
     let spheres = [sphere([0.0, 0.0, 10.0], 1.0), sphere([0.0, 0.0, 5.0], 1.0)];
     let quads = [quad([-5.0, -5.0, 20.0], [10.0, 0.0, 0.0], [0.0, 10.0, 0.0])];
     let r = ray([0.0; 3], [0.0, 0.0, 1.0]);
-    let hit = intersect_scene(&spheres, &quads, &r);
+    let hit = intersect_scene(&Geometry::new(&spheres, &quads), &r);
     assert!(close(hit.t, 4.0, 1e-6));
     assert!(hit.front_face);
     assert!((hit.normal - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
     // From inside, the normal is flipped to face the ray and front_face is false.
-    let hit = intersect_scene(&spheres, &[], &ray([0.0, 0.0, 5.0], [0.0, 0.0, 1.0]));
+    let hit = intersect_scene(
+        &Geometry::new(&spheres, &[]),
+        &ray([0.0, 0.0, 5.0], [0.0, 0.0, 1.0]),
+    );
     assert!(!hit.front_face);
     assert!((hit.normal - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
     assert_eq!(
-        intersect_scene(&spheres, &quads, &ray([0.0; 3], [0.0, 1.0, 0.0])).t,
+        intersect_scene(
+            &Geometry::new(&spheres, &quads),
+            &ray([0.0; 3], [0.0, 1.0, 0.0])
+        )
+        .t,
         NO_HIT
     );
 }
@@ -200,8 +208,8 @@ fn shadow_test_agrees_with_the_full_intersection() {
             [0.5, 0.3, 7.5]
         };
         let ray = ray(origin, [r * phi.cos(), r * phi.sin(), z]);
-        let hit = intersect_scene(&spheres, &quads, &ray);
-        let closest = closest_primitive(&spheres, &quads, &ray);
+        let hit = intersect_scene(&Geometry::new(&spheres, &quads), &ray);
+        let closest = closest_primitive(&Geometry::new(&spheres, &quads), &ray);
         assert_eq!(closest.t, hit.t);
         if hit.t == NO_HIT {
             met[2] += 1;
@@ -211,7 +219,10 @@ fn shadow_test_agrees_with_the_full_intersection() {
         for (primitive, count) in [(0, spheres.len()), (1, quads.len())] {
             for index in 0..count as u32 {
                 let same = (primitive, index) == (hit.primitive, hit.index);
-                assert_eq!(first_hit_is(&spheres, &quads, &ray, primitive, index), same);
+                assert_eq!(
+                    first_hit_is(&Geometry::new(&spheres, &quads), &ray, primitive, index),
+                    same
+                );
             }
         }
     }

@@ -5,7 +5,9 @@ use glint::shader::{
     render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
     SceneCounts, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
-use glint::shader_types::{Emitter, Material, Params, Quad, Sphere};
+use glint::shader_types::{
+    BvhNode, Emitter, Material, Params, Quad, Sphere, Triangle, TriangleNormals,
+};
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
 
@@ -99,7 +101,7 @@ fn rust_structs_match_wgsl_layout() {
             material_count,
             emitter_count,
             roulette_start,
-            pad0,
+            triangle_count,
             pad1
         ]
     );
@@ -140,6 +142,19 @@ fn rust_structs_match_wgsl_layout() {
         "Emitter",
         [primitive, index, cdf, probability]
     );
+    assert_same_layout!(
+        &module,
+        Triangle,
+        "Triangle",
+        [v0, material, v1, light_probability, v2, area]
+    );
+    assert_same_layout!(
+        &module,
+        TriangleNormals,
+        "TriangleNormals",
+        [n0, smooth_shading, n1, n2]
+    );
+    assert_same_layout!(&module, BvhNode, "BvhNode", [min, first, max, count]);
 }
 
 #[test]
@@ -243,15 +258,20 @@ fn every_feature_combination_validates() {
         materials: 5,
         emitters: 1,
     };
-    for bits in 0..32u32 {
+    for bits in 0..64u32 {
         let features = KernelFeatures {
             light_sampling: bits & 1 != 0,
             sphere_emitters: bits & 2 != 0,
             quad_emitters: bits & 4 != 0,
             metal: bits & 8 != 0,
             dielectric: bits & 16 != 0,
+            triangle_emitters: bits & 32 != 0,
         };
-        for binding in [SceneBinding::Storage, SceneBinding::Uniform(counts)] {
+        for binding in [
+            SceneBinding::Storage,
+            SceneBinding::Uniform(counts),
+            SceneBinding::Bvh,
+        ] {
             validate_source(render_kernel_source_for(KernelVariant {
                 binding,
                 features,

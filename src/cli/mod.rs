@@ -3,6 +3,7 @@
 mod bench;
 mod compare;
 mod render;
+mod stress_mesh;
 mod view;
 
 use crate::error::InputError;
@@ -30,6 +31,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Open a window that renders the scene progressively; fly around, watch it refine, save.
     View(view::ViewArgs),
+    /// Write a generated stress mesh (a displaced sphere, ~1M triangles by default) as PLY.
+    StressMesh(stress_mesh::StressMeshArgs),
 }
 
 /// Runs the command line; exit code 0 done, 2 bad input (scene or flags), 1 anything else.
@@ -44,6 +47,7 @@ pub fn main() -> ExitCode {
         Command::Compare(args) => compare::run(args),
         Command::Bench(args) => bench::run(args),
         Command::View(args) => view::run(args),
+        Command::StressMesh(args) => stress_mesh::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -221,6 +221,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "relative_error": relative_error(&mean, &variance),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
+            "triangles": kernel_scene.triangles.len(),
+            "bvh_nodes": kernel_scene.bvh_nodes.len(),
+            "bvh_build_seconds": kernel_scene.bvh_build_seconds,
+            "scene_bytes": kernel_scene.scene_bytes(),
         });
         println!("{summary}");
     }

@@ -1,8 +1,36 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
+use super::bvh::{bvh_closest_primitive, bvh_first_hit_is};
+use super::triangle::{hit_triangle, triangle_barycentrics, triangle_normal, triangle_ray};
 use super::Ray;
-use crate::shader_types::{Quad, Sphere, PRIMITIVE_QUAD, PRIMITIVE_SPHERE};
+use crate::shader_types::{
+    BvhNode, Quad, Sphere, Triangle, TriangleNormals, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    PRIMITIVE_TRIANGLE,
+};
 use glam::{BVec3, IVec3, Vec3};
+
+/// The scene's surfaces as the kernel's intersection code reads them. With `bvh_nodes` empty,
+/// every ray tests every primitive (the kernel's `USE_BVH = false`).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Geometry<'a> {
+    pub spheres: &'a [Sphere],
+    pub quads: &'a [Quad],
+    pub triangles: &'a [Triangle],
+    pub triangle_normals: &'a [TriangleNormals],
+    pub bvh_nodes: &'a [BvhNode],
+    pub bvh_primitives: &'a [u32],
+}
+
+impl<'a> Geometry<'a> {
+    /// Spheres and quads only, tested one by one.
+    pub fn new(spheres: &'a [Sphere], quads: &'a [Quad]) -> Geometry<'a> {
+        Geometry {
+            spheres,
+            quads,
+            ..Default::default()
+        }
+    }
+}
 
 pub const NO_HIT: f32 = 3.402823e38;
 
@@ -12,12 +40,16 @@ pub struct Hit {
     /// The hit point; on spheres projected back onto the surface, so errors cannot build up
     /// over many bounces.
     pub position: Vec3,
-    /// Geometric normal, unit length, facing against the incoming ray.
+    /// Geometric normal, unit length, facing against the incoming ray. It alone decides which
+    /// side of the surface a ray is on (offsets, entering or leaving glass).
     pub normal: Vec3,
+    /// The normal to shade with, on the geometric normal's side: interpolated vertex normals
+    /// on smooth triangles, the geometric normal elsewhere.
+    pub shading_normal: Vec3,
     pub material: u32,
     /// True when the ray hit the side the surface's outward normal points to.
     pub front_face: bool,
-    /// Which primitive: `PRIMITIVE_SPHERE` or `PRIMITIVE_QUAD`, and its index.
+    /// Which primitive: `PRIMITIVE_SPHERE`, `PRIMITIVE_QUAD` or `PRIMITIVE_TRIANGLE`, and its index.
     pub primitive: u32,
     pub index: u32,
 }
@@ -81,13 +113,16 @@ pub struct ClosestPrimitive {
     pub index: u32,
 }
 
-pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> ClosestPrimitive {
+pub fn closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
+    if !geometry.bvh_nodes.is_empty() {
+        return bvh_closest_primitive(geometry, ray);
+    }
     let mut best = ClosestPrimitive {
         t: NO_HIT,
         primitive: PRIMITIVE_QUAD,
         index: 0,
     };
-    for (i, s) in spheres.iter().enumerate() {
+    for (i, s) in geometry.spheres.iter().enumerate() {
         let t = hit_sphere(s, ray);
         if t < best.t {
             best = ClosestPrimitive {
@@ -97,7 +132,7 @@ pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Close
             };
         }
     }
-    for (i, q) in quads.iter().enumerate() {
+    for (i, q) in geometry.quads.iter().enumerate() {
         let t = hit_quad(q, ray);
         if t < best.t {
             best = ClosestPrimitive {
@@ -107,37 +142,50 @@ pub fn closest_primitive(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Close
             };
         }
     }
+    if !geometry.triangles.is_empty() {
+        let r = triangle_ray(ray);
+        for (i, tri) in geometry.triangles.iter().enumerate() {
+            let t = hit_triangle(tri, &r);
+            if t < best.t {
+                best = ClosestPrimitive {
+                    t,
+                    primitive: PRIMITIVE_TRIANGLE,
+                    index: i as u32,
+                };
+            }
+        }
+    }
     best
 }
 
 /// Whether the first thing `ray` meets is the primitive (`primitive`, `index`).
-pub fn first_hit_is(
-    spheres: &[Sphere],
-    quads: &[Quad],
-    ray: &Ray,
-    primitive: u32,
-    index: u32,
-) -> bool {
-    let closest = closest_primitive(spheres, quads, ray);
+pub fn first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u32) -> bool {
+    if !geometry.bvh_nodes.is_empty() {
+        return bvh_first_hit_is(geometry, ray, primitive, index);
+    }
+    let closest = closest_primitive(geometry, ray);
     closest.t != NO_HIT && closest.primitive == primitive && closest.index == index
 }
 
-/// The nearest hit of `ray` among all spheres and quads; `t == NO_HIT` when there is none.
-pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
-    let closest = closest_primitive(spheres, quads, ray);
+/// The nearest hit of `ray` among all primitives; `t == NO_HIT` when there is none.
+pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
+    let closest = closest_primitive(geometry, ray);
     if closest.t == NO_HIT {
         return Hit {
             t: NO_HIT,
             position: Vec3::ZERO,
             normal: Vec3::ZERO,
+            shading_normal: Vec3::ZERO,
             material: 0,
             front_face: false,
             primitive: 0,
             index: 0,
         };
     }
+    // Zero: shade with the geometric normal.
+    let mut shading = Vec3::ZERO;
     let (outward, position, material) = if closest.primitive == PRIMITIVE_SPHERE {
-        let s = &spheres[closest.index as usize];
+        let s = &geometry.spheres[closest.index as usize];
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
         let outward = (ray.origin + closest.t * ray.dir - Vec3::from(s.center)).normalize();
@@ -146,8 +194,22 @@ pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
             Vec3::from(s.center) + s.radius * outward,
             s.material,
         )
+    } else if closest.primitive == PRIMITIVE_TRIANGLE {
+        let tri = &geometry.triangles[closest.index as usize];
+        let b = triangle_barycentrics(tri, &triangle_ray(ray));
+        let n = &geometry.triangle_normals[closest.index as usize];
+        if n.smooth_shading != 0 {
+            shading = (b.x * Vec3::from(n.n0) + b.y * Vec3::from(n.n1) + b.z * Vec3::from(n.n2))
+                .normalize();
+        }
+        // On the triangle's plane, from its own vertices, as spheres are projected.
+        (
+            triangle_normal(tri),
+            b.x * Vec3::from(tri.v0) + b.y * Vec3::from(tri.v1) + b.z * Vec3::from(tri.v2),
+            tri.material,
+        )
     } else {
-        let q = &quads[closest.index as usize];
+        let q = &geometry.quads[closest.index as usize];
         (
             Vec3::from(q.normal),
             ray.origin + closest.t * ray.dir,
@@ -155,15 +217,33 @@ pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
         )
     };
     let front_face = outward.dot(ray.dir) < 0.0;
+    let normal = if front_face { outward } else { -outward };
+    let shading_normal = if shading != Vec3::ZERO {
+        if shading.dot(normal) >= 0.0 {
+            shading
+        } else {
+            -shading
+        }
+    } else {
+        normal
+    };
     Hit {
         t: closest.t,
         position,
-        normal: if front_face { outward } else { -outward },
+        normal,
+        shading_normal,
         material,
         front_face,
         primitive: closest.primitive,
         index: closest.index,
     }
+}
+
+/// Whether `dir` is on one side of the surface by the shading normal and on the other by the
+/// geometric normal: following it would leak light through a smooth-shaded surface, so such
+/// directions carry nothing. Never true where the shading normal is the geometric one.
+pub fn crosses_shading_side(dir: Vec3, hit: &Hit) -> bool {
+    dir.dot(hit.normal) * dir.dot(hit.shading_normal) < 0.0
 }
 
 /// Moves a surface point off the surface along `n`, by a few ulps of its own magnitude, so the

@@ -1,12 +1,13 @@
 //! Light sampling for next-event estimation (WGSL side: `shaders/lights.wgsl`). An emitter is
-//! chosen in proportion to its power, then a direction towards it: quads by area, spheres by
+//! chosen in proportion to its power, then a direction towards it: quads and triangles by area, spheres by
 //! the cone of directions they subtend from outside, and by area from inside. All pdfs are per
 //! unit solid angle at the shading point and include the selection probability.
 
 use super::material::{basis, PI};
 use super::rng::Rng;
 use super::trace::SceneRefs;
-use crate::shader_types::{Sphere, PRIMITIVE_QUAD};
+use super::triangle::{triangle_normal, triangle_plane_distance, triangle_point};
+use crate::shader_types::{Sphere, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -76,6 +77,20 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
     let u = (rng.next_f32(), rng.next_f32());
     out.primitive = e.primitive;
     out.index = e.index;
+    if e.primitive == PRIMITIVE_TRIANGLE {
+        // Uniform on the triangle's area.
+        let tri = &scene.triangles[e.index as usize];
+        let to_light = triangle_point(tri, u) - p;
+        let t = to_light.length();
+        if t <= 0.0 {
+            return out;
+        }
+        out.dir = to_light / t;
+        out.pdf =
+            e.probability * area_to_solid_angle(t, triangle_normal(tri).dot(out.dir), tri.area);
+        out.radiance = Vec3::from(scene.materials[tri.material as usize].emission);
+        return out;
+    }
     if e.primitive == PRIMITIVE_QUAD {
         let q = &scene.quads[e.index as usize];
         let to_light =
@@ -132,6 +147,16 @@ pub fn light_pdf(
     primitive: u32,
     index: u32,
 ) -> f32 {
+    if primitive == PRIMITIVE_TRIANGLE {
+        let tri = &scene.triangles[index as usize];
+        let normal = triangle_normal(tri);
+        let t = triangle_plane_distance(tri, normal, p, dir);
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if !(t > 0.0) {
+            return 0.0;
+        }
+        return tri.light_probability * area_to_solid_angle(t, normal.dot(dir), tri.area);
+    }
     if primitive == PRIMITIVE_QUAD {
         let q = &scene.quads[index as usize];
         let normal = Vec3::from(q.normal);

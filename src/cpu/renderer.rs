@@ -39,13 +39,7 @@ impl Renderer for CpuRenderer {
         let mut params = self.scene.params;
         params.sample_start = self.samples;
         params.sample_count = count;
-        let refs = SceneRefs {
-            params: &params,
-            spheres: &self.scene.spheres,
-            quads: &self.scene.quads,
-            materials: &self.scene.materials,
-            emitters: &self.scene.emitters,
-        };
+        let refs = SceneRefs::of(&self.scene, &params);
         let width = params.width as usize;
         let segments: u64 = self
             .stats

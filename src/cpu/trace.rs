@@ -1,12 +1,17 @@
 //! Path tracing (WGSL side: `shaders/trace.wgsl`).
 
 use super::camera::camera_ray;
-use super::intersect::{first_hit_is, intersect_scene, offset_ray_origin, NO_HIT};
+use super::intersect::{
+    crosses_shading_side, first_hit_is, intersect_scene, offset_ray_origin, Geometry, NO_HIT,
+};
 use super::lights::{light_pdf, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::Ray;
-use crate::shader_types::{Emitter, Material, Params, Quad, Sphere};
+use crate::scene::KernelScene;
+use crate::shader_types::{
+    BvhNode, Emitter, Material, Params, Quad, Sphere, Triangle, TriangleNormals,
+};
 use glam::Vec3;
 
 /// The scene as the kernel sees it.
@@ -16,6 +21,40 @@ pub struct SceneRefs<'a> {
     pub quads: &'a [Quad],
     pub materials: &'a [Material],
     pub emitters: &'a [Emitter],
+    pub triangles: &'a [Triangle],
+    pub triangle_normals: &'a [TriangleNormals],
+    /// Empty: every ray tests every primitive.
+    pub bvh_nodes: &'a [BvhNode],
+    pub bvh_primitives: &'a [u32],
+}
+
+impl<'a> SceneRefs<'a> {
+    /// `scene`'s arrays with `params` in place of its own.
+    pub fn of(scene: &'a KernelScene, params: &'a Params) -> SceneRefs<'a> {
+        SceneRefs {
+            params,
+            spheres: &scene.spheres,
+            quads: &scene.quads,
+            materials: &scene.materials,
+            emitters: &scene.emitters,
+            triangles: &scene.triangles,
+            triangle_normals: &scene.triangle_normals,
+            bvh_nodes: &scene.bvh_nodes,
+            bvh_primitives: &scene.bvh_primitives,
+        }
+    }
+
+    /// What intersection reads.
+    pub fn geometry(&self) -> Geometry<'a> {
+        Geometry {
+            spheres: self.spheres,
+            quads: self.quads,
+            triangles: self.triangles,
+            triangle_normals: self.triangle_normals,
+            bvh_nodes: self.bvh_nodes,
+            bvh_primitives: self.bvh_primitives,
+        }
+    }
 }
 
 /// A path in flight: what one more segment needs.
@@ -61,7 +100,7 @@ pub fn path_step(
     let ray = path.ray;
     let bounce = path.bounce;
     let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
-    let hit = intersect_scene(scene.spheres, scene.quads, &ray);
+    let hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
         path.radiance += path.throughput * Vec3::from(params.background);
@@ -97,22 +136,17 @@ pub fn path_step(
         // Next-event estimation: light arriving after one more scattering event.
         let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
         let light = sample_light(scene, p, origin, &mut light_rng);
-        if light.pdf > 0.0 {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.normal);
+        if light.pdf > 0.0 && !crosses_shading_side(light.dir, &hit) {
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal);
             if f_cos.cmpgt(Vec3::ZERO).any() {
                 let shadow = Ray {
                     origin,
                     dir: light.dir,
                 };
                 *segments += 1;
-                if first_hit_is(
-                    scene.spheres,
-                    scene.quads,
-                    &shadow,
-                    light.primitive,
-                    light.index,
-                ) {
-                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.normal));
+                if first_hit_is(&scene.geometry(), &shadow, light.primitive, light.index) {
+                    let weight =
+                        power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     path.radiance +=
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);
                 }
@@ -120,9 +154,9 @@ pub fn path_step(
         }
     }
     let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
-    let s = bsdf_sample(m, wo, hit.normal, hit.front_face, &mut bsdf_rng);
+    let s = bsdf_sample(m, wo, hit.shading_normal, hit.front_face, &mut bsdf_rng);
     let mut throughput = path.throughput * s.weight;
-    if throughput == Vec3::ZERO {
+    if throughput == Vec3::ZERO || crosses_shading_side(s.dir, &hit) {
         return true;
     }
     if bounce >= params.roulette_start {

@@ -2,6 +2,7 @@
 
 pub mod binding;
 pub mod context;
+pub mod limits;
 pub mod renderer;
 
 pub use context::{GpuContext, GpuUnavailable};

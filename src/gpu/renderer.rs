@@ -132,8 +132,9 @@ impl<'a> GpuRenderer<'a> {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
+        crate::gpu::limits::check_scene_fits(scene, max_binding)?;
         let (usage, scene_type) = match variant.binding {
-            SceneBinding::Storage => (
+            SceneBinding::Storage | SceneBinding::Bvh => (
                 wgpu::BufferUsages::STORAGE,
                 wgpu::BufferBindingType::Storage { read_only: true },
             ),
@@ -146,6 +147,12 @@ impl<'a> GpuRenderer<'a> {
         let quads = scene_buffer(ctx, "quads", &scene.quads, usage);
         let materials = scene_buffer(ctx, "materials", &scene.materials, usage);
         let emitters = scene_buffer(ctx, "emitters", &scene.emitters, usage);
+        // Meshes and the BVH are always in storage buffers (placeholders when unused).
+        let triangles = storage_buffer(ctx, "triangles", &scene.triangles);
+        let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
+        let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
+        let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+        let read_only = wgpu::BufferBindingType::Storage { read_only: true };
         let accumulator = |label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -185,6 +192,10 @@ impl<'a> GpuRenderer<'a> {
                 (5, read_write, &m2_buffer),
                 (6, scene_type, &emitters),
                 (7, read_write, &counter_buffer),
+                (8, read_only, &triangles),
+                (9, read_only, &triangle_normals),
+                (12, read_only, &bvh_nodes),
+                (13, read_only, &bvh_primitives),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -55,6 +55,8 @@ pub(super) struct SceneToml {
     pub(super) spheres: Vec<S<SphereToml>>,
     #[serde(default)]
     pub(super) quads: Vec<S<QuadToml>>,
+    #[serde(default)]
+    pub(super) meshes: Vec<S<MeshToml>>,
 }
 
 #[derive(Deserialize)]
@@ -108,4 +110,24 @@ pub(super) struct QuadToml {
     pub(super) u: S<[Real; 3]>,
     pub(super) v: S<[Real; 3]>,
     pub(super) material: S<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MeshToml {
+    /// Relative to the scene file's folder.
+    pub(super) file: S<String>,
+    pub(super) material: Option<S<String>>,
+    pub(super) translate: Option<S<[Real; 3]>>,
+    pub(super) rotate: Option<S<[Real; 3]>>,
+    pub(super) scale: Option<S<ScaleToml>>,
+    pub(super) smooth: Option<bool>,
+}
+
+/// `scale = 2.0` or `scale = [1.0, 2.0, 1.0]`.
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(super) enum ScaleToml {
+    Uniform(Real),
+    PerAxis([Real; 3]),
 }

@@ -1,10 +1,12 @@
 //! The validated scene laid out as the kernel's `#[repr(C)]` structs, and the emitter table
 //! that light sampling draws from.
 
+use super::bvh;
 use super::{CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::shader_types::{
-    self, Emitter, Params, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL,
-    MATERIAL_SPECULAR, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, ROULETTE_OFF,
+    self, BvhNode, Emitter, Params, TriangleNormals, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
+    MATERIAL_METAL, MATERIAL_SPECULAR, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    ROULETTE_OFF,
 };
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
@@ -15,6 +17,51 @@ pub struct KernelScene {
     pub quads: Vec<shader_types::Quad>,
     pub materials: Vec<shader_types::Material>,
     pub emitters: Vec<Emitter>,
+    pub triangles: Vec<shader_types::Triangle>,
+    /// One per triangle.
+    pub triangle_normals: Vec<TriangleNormals>,
+    /// The BVH over all primitives; empty for scenes small enough to test every primitive
+    /// (see [`bvh::wants_bvh`]).
+    pub bvh_nodes: Vec<BvhNode>,
+    pub bvh_primitives: Vec<u32>,
+    pub bvh_build_seconds: f64,
+}
+
+impl KernelScene {
+    /// Bytes of the scene's arrays on the device (all but the image's accumulators).
+    pub fn scene_bytes(&self) -> u64 {
+        fn bytes<T>(items: &[T]) -> u64 {
+            std::mem::size_of_val(items) as u64
+        }
+        bytes(&self.spheres)
+            + bytes(&self.quads)
+            + bytes(&self.materials)
+            + bytes(&self.emitters)
+            + bytes(&self.triangles)
+            + bytes(&self.triangle_normals)
+            + bytes(&self.bvh_nodes)
+            + bytes(&self.bvh_primitives)
+    }
+
+    /// The largest single array, with its name: each must fit one storage binding.
+    pub fn largest_array(&self) -> (&'static str, u64) {
+        fn bytes<T>(items: &[T]) -> u64 {
+            std::mem::size_of_val(items) as u64
+        }
+        [
+            ("spheres", bytes(&self.spheres)),
+            ("quads", bytes(&self.quads)),
+            ("materials", bytes(&self.materials)),
+            ("emitters", bytes(&self.emitters)),
+            ("triangles", bytes(&self.triangles)),
+            ("triangle normals", bytes(&self.triangle_normals)),
+            ("BVH nodes", bytes(&self.bvh_nodes)),
+            ("BVH primitive references", bytes(&self.bvh_primitives)),
+        ]
+        .into_iter()
+        .max_by_key(|&(_, b)| b)
+        .unwrap_or(("spheres", 0))
+    }
 }
 
 impl Scene {
@@ -30,7 +77,12 @@ impl Scene {
         let half_height = (c.vfov.to_radians() * 0.5).tan();
         let half_width = half_height * r.width as f32 / r.height as f32;
         let lens_radius = 0.5 * c.aperture;
-        let (emitters, sphere_light_probability, quad_light_probability) = self.emitter_table();
+        let (
+            emitters,
+            sphere_light_probability,
+            quad_light_probability,
+            triangle_light_probability,
+        ) = self.emitter_table();
         let params = Params {
             eye: c.eye.into(),
             width: r.width,
@@ -56,7 +108,7 @@ impl Scene {
             } else {
                 ROULETTE_OFF
             },
-            pad0: 0,
+            triangle_count: self.triangles.len() as u32,
             pad1: 0,
         };
         let spheres = self
@@ -115,19 +167,70 @@ impl Scene {
                 }
             })
             .collect();
-        KernelScene {
+        let triangles: Vec<shader_types::Triangle> = self
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let [a, b, c] = t.vertices;
+                shader_types::Triangle {
+                    v0: a.into(),
+                    material: t.material,
+                    v1: b.into(),
+                    light_probability: triangle_light_probability[i],
+                    v2: c.into(),
+                    area: 0.5 * (b - a).cross(c - a).length(),
+                }
+            })
+            .collect();
+        let triangle_normals = self
+            .triangles
+            .iter()
+            .map(|t| match t.normals {
+                Some([n0, n1, n2]) => TriangleNormals {
+                    n0: n0.into(),
+                    smooth_shading: 1,
+                    n1: n1.into(),
+                    n2: n2.into(),
+                    ..Default::default()
+                },
+                None => TriangleNormals::default(),
+            })
+            .collect();
+        let mut scene = KernelScene {
             params,
             spheres,
             quads,
             materials,
             emitters,
+            triangles,
+            triangle_normals,
+            bvh_nodes: Vec::new(),
+            bvh_primitives: Vec::new(),
+            bvh_build_seconds: 0.0,
+        };
+        if bvh::wants_bvh(
+            scene.spheres.len(),
+            scene.quads.len(),
+            scene.triangles.len(),
+        ) {
+            // Validation bounds the primitive count far below what a reference holds, and
+            // trees from PLOC are far shallower than the stack, so this cannot fail for a
+            // scene that loaded.
+            let tree = bvh::build(&scene.spheres, &scene.quads, &scene.triangles)
+                .unwrap_or_else(|e| panic!("BVH build: {e}"));
+            scene.bvh_nodes = tree.nodes;
+            scene.bvh_primitives = tree.primitives;
+            scene.bvh_build_seconds = tree.build_seconds;
         }
+        scene
     }
 
     /// Every emitting primitive with its selection probability, proportional to its power
     /// (mean emitted radiance × area; the factor π is common to all), and that probability per
-    /// sphere and per quad (0 for those that do not emit).
-    fn emitter_table(&self) -> (Vec<Emitter>, Vec<f32>, Vec<f32>) {
+    /// sphere, per quad and per triangle (0 for those that do not emit).
+    #[allow(clippy::type_complexity)]
+    fn emitter_table(&self) -> (Vec<Emitter>, Vec<f32>, Vec<f32>, Vec<f32>) {
         let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
         let mut powers: Vec<(u32, u32, f64)> = Vec::new();
         for (i, s) in self.spheres.iter().enumerate() {
@@ -144,6 +247,15 @@ impl Scene {
                 radiance(q.material).element_sum() as f64 / 3.0 * q.u.cross(q.v).length() as f64;
             if power > 0.0 {
                 powers.push((PRIMITIVE_QUAD, i as u32, power));
+            }
+        }
+        for (i, t) in self.triangles.iter().enumerate() {
+            let [a, b, c] = t.vertices;
+            let power = radiance(t.material).element_sum() as f64 / 3.0
+                * 0.5
+                * (b - a).cross(c - a).length() as f64;
+            if power > 0.0 {
+                powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }
         }
         let total: f64 = powers.iter().map(|p| p.2).sum();
@@ -165,14 +277,20 @@ impl Scene {
         }
         let mut sphere_probability = vec![0.0; self.spheres.len()];
         let mut quad_probability = vec![0.0; self.quads.len()];
+        let mut triangle_probability = vec![0.0; self.triangles.len()];
         for e in &emitters {
-            let per_primitive = if e.primitive == PRIMITIVE_SPHERE {
-                &mut sphere_probability
-            } else {
-                &mut quad_probability
+            let per_primitive = match e.primitive {
+                PRIMITIVE_SPHERE => &mut sphere_probability,
+                PRIMITIVE_QUAD => &mut quad_probability,
+                _ => &mut triangle_probability,
             };
             per_primitive[e.index as usize] = e.probability;
         }
-        (emitters, sphere_probability, quad_probability)
+        (
+            emitters,
+            sphere_probability,
+            quad_probability,
+            triangle_probability,
+        )
     }
 }

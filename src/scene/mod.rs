@@ -7,8 +7,11 @@
 //! The parts, in the order data flows: [`file`] is the TOML as written, [`validate`] turns it
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
+pub mod bvh;
 mod file;
 mod kernel;
+pub mod mesh;
+pub mod stress;
 mod validate;
 
 pub use kernel::KernelScene;
@@ -66,6 +69,16 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub spheres: Vec<Sphere>,
     pub quads: Vec<Quad>,
+    /// Every mesh's triangles, in the scene's coordinates.
+    pub triangles: Vec<Triangle>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Triangle {
+    pub vertices: [Vec3; 3],
+    /// Unit vertex normals to interpolate for shading; `None` shades with the geometric normal.
+    pub normals: Option<[Vec3; 3]>,
+    pub material: u32,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -219,8 +232,14 @@ impl Scene {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "scene".into());
-        raw.validate(name)
-            .map_err(|e| at(e.span, Some(e.field), e.message))
+        let folder = path.parent().unwrap_or(Path::new(""));
+        let (scene, warnings) = raw
+            .validate(name, folder)
+            .map_err(|e| at(e.span, Some(e.field), e.message))?;
+        for w in warnings {
+            eprintln!("glint: warning: {}: {w}", path.display());
+        }
+        Ok(scene)
     }
 
     /// Applies command-line overrides and checks the result as the scene's own values are checked.

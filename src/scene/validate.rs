@@ -1,7 +1,8 @@
 //! From the file as written to a validated [`Scene`]: every range, reference and degenerate
 //! case checked, each failure tied to its field and its place in the file.
 
-use super::file::{Real, SceneToml, S};
+use super::file::{Real, ScaleToml, SceneToml, S};
+use super::mesh::{self, MeshTransform};
 use super::{
     check_image_size, check_range, Camera, Material, MaterialKind, Quad, RenderSettings, Scene,
     Sphere, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
@@ -9,6 +10,7 @@ use super::{
 use glam::Vec3;
 use std::collections::BTreeMap;
 use std::ops::Range;
+use std::path::Path;
 
 /// A validation failure before it is given the file name and a line.
 pub(super) struct FieldError {
@@ -73,7 +75,12 @@ fn int_in(x: &S<i64>, field: &str, min: i64, max: i64) -> Result<u32, FieldError
 }
 
 impl SceneToml {
-    pub(super) fn validate(self, name: String) -> Result<Scene, FieldError> {
+    /// The scene, and warnings to print; mesh files are read relative to `folder`.
+    pub(super) fn validate(
+        self,
+        name: String,
+        folder: &Path,
+    ) -> Result<(Scene, Vec<String>), FieldError> {
         let whole = |field: &str, message: String| FieldError {
             span: None,
             field: field.into(),
@@ -358,7 +365,70 @@ impl SceneToml {
                 material,
             });
         }
-        Ok(Scene {
+        let mut triangles = Vec::new();
+        let mut warnings = Vec::new();
+        for (i, m) in self.meshes.iter().enumerate() {
+            let m = m.get_ref();
+            let field = |f: &str| format!("meshes[{i}].{f}");
+            let translate = match &m.translate {
+                Some(t) => vec3(t, &field("translate"))?,
+                None => Vec3::ZERO,
+            };
+            let rotate = match &m.rotate {
+                Some(r) => vec3(r, &field("rotate"))?,
+                None => Vec3::ZERO,
+            };
+            let scale = match &m.scale {
+                None => Vec3::ONE,
+                Some(s) => {
+                    let v = match s.get_ref() {
+                        ScaleToml::Uniform(r) => Vec3::splat(r.0 as f32),
+                        ScaleToml::PerAxis(a) => {
+                            Vec3::new(a[0].0 as f32, a[1].0 as f32, a[2].0 as f32)
+                        }
+                    };
+                    if !v.is_finite() || v.min_element() <= 0.0 {
+                        return fail(
+                            s.span(),
+                            field("scale"),
+                            format!("degenerate transform: every scale factor must be finite and > 0, got {v}"),
+                        );
+                    }
+                    v
+                }
+            };
+            let material = match &m.material {
+                Some(name) => Some(material_ref(name, field("material"))?),
+                None => None,
+            };
+            let file = m.file.get_ref();
+            let loaded = mesh::load(
+                &folder.join(file),
+                file,
+                &MeshTransform {
+                    scale,
+                    rotate_degrees: rotate,
+                    translate,
+                },
+                material,
+                m.smooth.unwrap_or(true),
+                &mut materials,
+            )
+            .or_else(|message| fail(m.file.span(), field("file"), message))?;
+            warnings.extend(loaded.warnings);
+            triangles.extend(loaded.triangles);
+            if triangles.len() > mesh::MAX_TRIANGLES {
+                return fail(
+                    m.file.span(),
+                    field("file"),
+                    format!(
+                        "the scene's meshes hold more than {} triangles",
+                        mesh::MAX_TRIANGLES
+                    ),
+                );
+            }
+        }
+        let scene = Scene {
             name,
             camera: Camera {
                 eye,
@@ -381,6 +451,8 @@ impl SceneToml {
             materials,
             spheres,
             quads,
-        })
+            triangles,
+        };
+        Ok((scene, warnings))
     }
 }

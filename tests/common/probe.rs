@@ -56,6 +56,10 @@ pub fn run_probe(
     let quads = storage_buffer(ctx, "quads", &scene.quads);
     let materials = storage_buffer(ctx, "materials", &scene.materials);
     let emitters = storage_buffer(ctx, "emitters", &scene.emitters);
+    let triangles = storage_buffer(ctx, "triangles", &scene.triangles);
+    let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
+    let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
+    let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -81,6 +85,10 @@ pub fn run_probe(
             (2, read_only, &quads),
             (3, read_only, &materials),
             (6, read_only, &emitters),
+            (8, read_only, &triangles),
+            (9, read_only, &triangle_normals),
+            (12, read_only, &bvh_nodes),
+            (13, read_only, &bvh_primitives),
             (10, wgpu::BufferBindingType::Uniform, &probe_params),
             (11, read_write, &out),
         ],
