@@ -267,8 +267,8 @@ fn reference_light_pdf(scene: &glint::scene::Scene, p: glam::DVec3, dir: glam::D
     pdf
 }
 
-/// TWO_LIGHTS with an emitting triangle mesh added (an open pyramid of four triangles, two
-/// materials), so light sampling chooses among spheres, quads and triangles by power.
+/// TWO_LIGHTS with four emitting triangles added (a fan, two materials), so light sampling
+/// chooses among spheres, quads and triangles by power.
 fn lights_with_triangles() -> glint::scene::Scene {
     let mut scene = common::scene(&format!(
         "{SCENE_HEADER}{TWO_LIGHTS}
@@ -285,12 +285,14 @@ emission = [1.0, 1.0, 1.0]
     ));
     let index = |name: &str| scene.materials.iter().position(|m| m.name == name).unwrap() as u32;
     let (bright, dim) = (index("tri_lamp"), index("tri_lamp_dim"));
-    let apex = Vec3::new(-1.2, -0.5, 1.8);
+    // A flat fan (on one tilted plane), so no direction from the origin meets two of them
+    // and each sample's pdf is its own triangle's.
+    let apex = Vec3::new(-1.25, -1.2, 1.8);
     let base = [
         Vec3::new(-2.0, -1.5, 1.0),
         Vec3::new(-0.5, -1.5, 1.2),
-        Vec3::new(-0.8, -1.0, 2.6),
-        Vec3::new(-2.2, -0.8, 2.4),
+        Vec3::new(-0.5, -0.9, 2.6),
+        Vec3::new(-2.0, -0.9, 2.4),
     ];
     for k in 0..4 {
         scene.triangles.push(glint::scene::Triangle {

@@ -60,10 +60,18 @@ fn tiled_cornell(tiles: u32, size: u32, seed: u32) -> KernelScene {
     sized(common::scene(&toml), size, seed)
 }
 
-/// The choice: uniform buffers while the largest array fits both the device's limit and
-/// 64 KiB, storage buffers beyond.
+/// The linear scan (the scene without its BVH, as in scenes of at most 64 spheres and quads):
+/// uniform buffers while the largest array fits both the device's limit and 64 KiB, storage
+/// buffers beyond.
+fn without_bvh(mut scene: KernelScene) -> KernelScene {
+    scene.bvh_nodes.clear();
+    scene.bvh_primitives.clear();
+    scene
+}
+
 #[test]
 fn scenes_too_large_for_uniform_buffers_use_storage_buffers() {
+    let tiled_cornell = |tiles, size, seed| without_bvh(tiled_cornell(tiles, size, seed));
     let cornell = common::cornell_at(16, 0);
     assert_eq!(
         SceneBinding::for_scene(&cornell, 65536),
@@ -91,14 +99,20 @@ fn scenes_too_large_for_uniform_buffers_use_storage_buffers() {
     );
 }
 
-/// A scene over the uniform limit renders through storage buffers and traces the same paths
-/// as the CPU reference (the criterion of tests/gpu_vs_cpu.rs).
+/// A scene over the uniform limit renders through storage buffers (and, having more than 64
+/// objects, its BVH) and traces the same paths as the CPU reference (the criterion of
+/// tests/gpu_vs_cpu.rs); so does the same scene scanned linearly from storage buffers.
 #[test]
 fn large_scene_renders_through_storage_buffers_like_the_cpu() {
     let Some(ctx) = gpu() else { return };
     let mut agreement = common::PathAgreement::default();
     for seed in [1, 2] {
         let scene = tiled_cornell(700, 64, seed);
+        let mut renderer = GpuRenderer::new(ctx, &scene).unwrap();
+        assert_eq!(renderer.scene_binding(), SceneBinding::Bvh);
+        let gpu_image = render_image(&mut renderer, 1, 1).unwrap();
+        agreement.add(&render_cpu(&scene, 1), &gpu_image);
+        let scene = without_bvh(scene);
         let mut renderer = GpuRenderer::new(ctx, &scene).unwrap();
         assert_eq!(renderer.scene_binding(), SceneBinding::Storage);
         let gpu_image = render_image(&mut renderer, 1, 1).unwrap();
