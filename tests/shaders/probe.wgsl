@@ -79,3 +79,27 @@ fn probe_dielectric(@builtin(global_invocation_id) id: vec3<u32>) {
     let s = bsdf_sample(probe_material(MATERIAL_DIELECTRIC), probe.wo, probe.normal, probe.front_face != 0u, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
+
+// Watertightness: rays from points near probe.position (inside the bound scene's closed mesh,
+// within probe.alpha / 2 per axis) aimed exactly at a triangle's first vertex, the midpoint of
+// its first edge, or a random point on that edge; writes the t of the closest hit (NO_HIT for a
+// ray that slipped through).
+@compute @workgroup_size(256, 1, 1)
+fn probe_watertight(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let n = params.triangle_count;
+    let tri = triangles[min(u32(rng_next(&rng) * f32(n)), n - 1u)];
+    let along = rng_next(&rng);
+    var aim = tri.v0;
+    if id.x % 3u == 1u {
+        aim = 0.5 * (tri.v0 + tri.v1);
+    } else if id.x % 3u == 2u {
+        aim = mix(tri.v0, tri.v1, along);
+    }
+    let jitter = vec3<f32>(rng_next(&rng), rng_next(&rng), rng_next(&rng)) - vec3<f32>(0.5);
+    let origin = probe.position + probe.alpha * jitter;
+    probe_out[id.x] = vec4<f32>(closest_primitive(Ray(origin, normalize(aim - origin))).t, 0.0, 0.0, 0.0);
+}
