@@ -136,7 +136,7 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
-    let n_old = f32(params.sample_start);
+    let n_old = f32(params.accumulated_samples);
     let n_new = f32(params.sample_count);
     let n = n_old + n_new;
     let old_mean = accum_mean[pixel].xyz;

@@ -4,13 +4,17 @@
 //! Data flows one way: scene file → [`scene::Scene`] (validated) → [`scene::KernelScene`]
 //! (the kernel's structs) → a [`render::Renderer`] (GPU or CPU) → [`output::Image`].
 
+pub mod accumulation;
 pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod cpu;
 pub mod error;
 pub mod gpu;
+pub mod interrupt;
+pub mod merge;
 pub mod output;
+pub mod partial;
 pub mod render;
 pub mod scene;
 pub mod shader;

@@ -33,7 +33,9 @@ pub struct Params {
     pub emitter_count: u32,
     /// Russian roulette after the scattering at this bounce and later ones (`ROULETTE_OFF`: off).
     pub roulette_start: u32,
-    pub pad0: u32,
+    /// Samples already in the accumulators (the pairwise merge's n_old): `sample_start` less
+    /// the first sample of a partial render (`--samples A..B`), which need not start at 0.
+    pub accumulated_samples: u32,
     pub pad1: u32,
 }
 

@@ -99,7 +99,7 @@ fn rust_structs_match_wgsl_layout() {
             material_count,
             emitter_count,
             roulette_start,
-            pad0,
+            accumulated_samples,
             pad1
         ]
     );

@@ -1,20 +1,22 @@
 //! `glint render`.
 
+use super::render_writer::RenderWriter;
+use super::sample_range::{self, SampleRangeArgs};
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
+use crate::interrupt::{self, Interrupted};
 use crate::output::{check_output_path, ImageFormat};
+use crate::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// How often the output file is refreshed with the running image.
-const CHECKPOINT_INTERVAL: Duration = Duration::from_secs(3);
 /// Wanted duration of one GPU submission: short enough for a desktop GPU's watchdog and a
 /// responsive progress bar, long enough that per-batch overhead stays small.
 const BATCH_TARGET: Duration = Duration::from_millis(250);
@@ -66,6 +68,12 @@ pub struct RenderArgs {
     /// ("wall_seconds" is the whole command).
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub range: SampleRangeArgs,
+    /// Refresh the output with the running image (a resumable partial file for .exr) every
+    /// this many seconds; 0: after every batch.
+    #[arg(long, value_name = "SECONDS", value_parser = sample_range::parse_interval, default_value = "3")]
+    pub checkpoint_interval: Duration,
 }
 
 fn parse_seconds(s: &str) -> Result<f64, String> {
@@ -92,11 +100,6 @@ fn parse_target_error(s: &str) -> Result<f64, String> {
         return Err(format!("must be a finite number > 0, got {s}"));
     }
     Ok(v)
-}
-
-fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene.file_stem().unwrap_or_else(|| "render".as_ref());
-    PathBuf::from(stem).with_extension("png")
 }
 
 /// Either a GPU renderer or, where there is none, the CPU reference.
@@ -128,11 +131,24 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let scene = scene
         .with_overrides(&overrides)
         .map_err(|m| InputError(format!("{}: {m}", args.scene.display())))?;
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.scene));
+    let kernel_scene = scene.kernel_scene();
+    let settings = &scene.render;
+    let (width, height) = (settings.width, settings.height);
+    let settings_hash = settings_hash(&kernel_scene);
+    let plan = sample_range::plan(&args.range, settings.spp, &settings_hash, (width, height))?;
+    let output = args.output.clone().unwrap_or_else(|| {
+        sample_range::default_output(&args.scene, &plan, &args.range, settings.spp)
+    });
     check_output_path(&output).map_err(InputError)?;
+    if plan.is_partial(settings.spp) && ImageFormat::from_path(&output) != Ok(ImageFormat::Exr) {
+        return Err(InputError(format!(
+            "{}: a partial render (samples {} of {}) needs an .exr output to hold what a merge needs",
+            output.display(),
+            format_range(&plan.target),
+            settings.spp
+        ))
+        .into());
+    }
     if let Some(variance) = &args.variance {
         check_output_path(variance).map_err(InputError)?;
         if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
@@ -144,17 +160,31 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
     }
 
-    let kernel_scene = scene.kernel_scene();
     let gpu = open_gpu(&args)?;
     let mut renderer: Box<dyn Renderer + '_> = match &gpu {
         Some(ctx) => Box::new(GpuRenderer::new(ctx, &kernel_scene)?),
         None => Box::new(CpuRenderer::new(&kernel_scene)),
     };
 
-    let settings = &scene.render;
-    let (width, height) = (settings.width, settings.height);
+    plan.start(renderer.as_mut())?;
+    let mut writer = RenderWriter::new(
+        output.clone(),
+        args.variance.clone(),
+        PartialInfo {
+            ranges: Vec::new(),
+            target: plan.target.clone(),
+            spp: settings.spp,
+            seed: settings.seed,
+            settings: settings_hash,
+            scene: args.scene.display().to_string(),
+            device: renderer.device_name(),
+        },
+    );
     let progress = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(settings.spp as u64), ProgressDrawTarget::stderr())
+        ProgressBar::with_draw_target(
+            Some(plan.samples_wanted() as u64),
+            ProgressDrawTarget::stderr(),
+        )
     } else {
         ProgressBar::hidden()
     };
@@ -168,10 +198,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let rules = StopRules {
         time_limit: args.time_limit.map(Duration::from_secs_f64),
         target_error: args.target_error,
+        interrupted: Some(interrupt::install()?),
     };
     let stats = render_progressive(
         renderer.as_mut(),
-        settings.spp,
+        plan.samples_wanted(),
         rules,
         &mut sizer,
         |r, report| {
@@ -183,28 +214,23 @@ pub fn run(args: RenderArgs) -> Result<()> {
             }
             progress.set_message(message);
             if report.spp_done < report.spp_target
-                && last_checkpoint.elapsed() >= CHECKPOINT_INTERVAL
+                && last_checkpoint.elapsed() >= args.checkpoint_interval
             {
-                r.read_mean()?.write(&output)?;
+                writer.checkpoint(r)?;
                 last_checkpoint = Instant::now();
             }
             Ok(())
         },
     )?;
     progress.finish_and_clear();
-    let mean = renderer.read_mean()?;
-    let variance = renderer.read_variance()?;
-    mean.write(&output)
-        .with_context(|| format!("writing {}", output.display()))?;
-    if let Some(path) = &args.variance {
-        variance
-            .write(path)
-            .with_context(|| format!("writing {}", path.display()))?;
-    }
+    let (mean, variance) = writer.finish(renderer.as_mut())?;
+    let first = renderer.first_sample();
 
     if args.json {
         let seconds = stats.render_time.as_secs_f64();
-        let paths = pixels as u64 * stats.spp as u64;
+        // This run's paths only, not a resumed file's.
+        let resumed = plan.resumed.as_ref().map_or(0, |p| p.accumulation.count);
+        let paths = pixels as u64 * (stats.spp - resumed) as u64;
         let summary = serde_json::json!({
             "scene": args.scene.display().to_string(),
             "output": output.display().to_string(),
@@ -221,8 +247,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "relative_error": relative_error(&mean, &variance),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
+            "samples": [first, first + stats.spp],
         });
         println!("{summary}");
+    }
+    if let Some(signal) = interrupt::requested() {
+        return Err(Interrupted {
+            signal,
+            message: format!(
+                "interrupted by {} at {} spp; wrote samples {} to {} (continue with --resume)",
+                interrupt::name(signal),
+                stats.spp,
+                format_range(&(first..first + stats.spp)),
+                output.display()
+            ),
+        }
+        .into());
     }
     Ok(())
 }

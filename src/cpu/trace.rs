@@ -180,8 +180,8 @@ pub struct PixelStats {
 }
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
-/// `params.sample_start`, merged into `stats`, which holds the `params.sample_start` samples
-/// before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
+/// `params.sample_start`, merged into `stats`, which holds the `params.accumulated_samples`
+/// samples before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
 /// for SIMD efficiency; each sample's result is the same, and they finish in the same order.)
 pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
     let params = scene.params;
@@ -197,7 +197,7 @@ pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats)
         m2 += delta * (x - mean);
     }
     // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
-    let n_old = params.sample_start as f32;
+    let n_old = params.accumulated_samples as f32;
     let n_new = params.sample_count as f32;
     let n = n_old + n_new;
     let delta = mean - stats.mean;

@@ -2,8 +2,9 @@
 
 use super::binding::{compute_bind_group, compute_pipeline};
 use super::context::GpuContext;
+use crate::accumulation::Accumulation;
 use crate::output::Image;
-use crate::render::{variance_of_mean, Renderer};
+use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use crate::shader::{
     render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding, RENDER_ENTRY_POINT,
@@ -27,6 +28,7 @@ pub struct GpuRenderer<'a> {
     m2_buffer: wgpu::Buffer,
     readback_buffer: wgpu::Buffer,
     samples: u32,
+    first_sample: u32,
     /// The kernel's segment counter (one u32).
     counter_buffer: wgpu::Buffer,
     /// Benchmark instrumentation, off unless asked for: it reads back after every batch.
@@ -210,6 +212,7 @@ impl<'a> GpuRenderer<'a> {
             m2_buffer,
             readback_buffer,
             samples: 0,
+            first_sample: 0,
             counter_buffer,
             instruments: None,
         })
@@ -340,7 +343,8 @@ impl<'a> GpuRenderer<'a> {
 
 impl Renderer for GpuRenderer<'_> {
     fn add_samples(&mut self, count: u32) -> Result<()> {
-        self.params.sample_start = self.samples;
+        self.params.sample_start = self.first_sample + self.samples;
+        self.params.accumulated_samples = self.samples;
         self.params.sample_count = count;
         self.ctx
             .queue
@@ -378,6 +382,40 @@ impl Renderer for GpuRenderer<'_> {
 
     fn samples(&self) -> u32 {
         self.samples
+    }
+
+    fn first_sample(&self) -> u32 {
+        self.first_sample
+    }
+
+    fn read_accumulation(&mut self) -> Result<Accumulation> {
+        Ok(Accumulation {
+            width: self.params.width,
+            height: self.params.height,
+            count: self.samples,
+            mean: self.read_vec3s(&self.mean_buffer)?,
+            m2: self.read_vec3s(&self.m2_buffer)?,
+        })
+    }
+
+    fn load_accumulation(&mut self, first_sample: u32, state: Option<&Accumulation>) -> Result<()> {
+        self.reset()?;
+        if let Some(state) = state {
+            check_size(&self.params, state)?;
+            let vec4s = |v: &[[f32; 3]]| -> Vec<[f32; 4]> {
+                v.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect()
+            };
+            let queue = &self.ctx.queue;
+            queue.write_buffer(
+                &self.mean_buffer,
+                0,
+                bytemuck::cast_slice(&vec4s(&state.mean)),
+            );
+            queue.write_buffer(&self.m2_buffer, 0, bytemuck::cast_slice(&vec4s(&state.m2)));
+            self.samples = state.count;
+        }
+        self.first_sample = first_sample;
+        self.ctx.wait_idle()
     }
 
     fn read_mean(&mut self) -> Result<Image> {

@@ -56,7 +56,7 @@ impl Scene {
             } else {
                 ROULETTE_OFF
             },
-            pad0: 0,
+            accumulated_samples: 0,
             pad1: 0,
         };
         let spheres = self
