@@ -72,7 +72,7 @@ pub fn merge(mut parts: Vec<Part>, allow_gaps: bool) -> Result<Merged, String> {
         if b.start < a.end {
             let what = if name_a == name_b {
                 format!(
-                    "{name_a} holds samples {} twice",
+                    "{name_a} overlaps itself in samples {} (a file given twice?)",
                     format_range(&(b.start..a.end.min(b.end)))
                 )
             } else {
