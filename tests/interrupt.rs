@@ -147,34 +147,38 @@ fn sigterm_writes_what_is_done_and_exits_143() {
 fn resuming_after_sigkill_gives_the_uninterrupted_image() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let spp = ["--spp", "256"];
+    let spp = ["--spp", "2048"];
+    let started = Instant::now();
     let single = render_command(d, &spp)
         .args(["-o", "single.exr"])
         .output()
         .unwrap();
+    let render_time = started.elapsed();
     assert!(
         single.status.success(),
         "{}",
         String::from_utf8_lossy(&single.stderr)
     );
     let single = read(&d.join("single.exr"));
-    // Kill at moments that vary from run to run (printed, to reproduce a failure), twice, then
-    // let the last resume finish.
+    // Kill at moments that vary from run to run (printed, to reproduce a failure): within the
+    // first 10–60% of an uninterrupted render's time, twice, then let the last resume finish.
     let nanos = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .unwrap()
         .subsec_nanos();
-    for (round, delay_ms) in [50 + nanos % 900, 50 + (nanos / 1000) % 900]
+    let mut killed_mid_render = false;
+    for (round, fraction) in [nanos % 1000, (nanos / 1000) % 1000]
         .into_iter()
         .enumerate()
     {
+        let delay_ms = render_time.as_millis() as u64 * (100 + fraction as u64 / 2) / 1000;
         let mut command = render_command(d, &spp);
         command.args(["-o", "out.exr", "--checkpoint-interval", "0"]);
         if d.join("out.exr").exists() {
             command.args(["--resume", "out.exr"]);
         }
         let mut child = command.spawn().unwrap();
-        std::thread::sleep(Duration::from_millis(delay_ms as u64));
+        std::thread::sleep(Duration::from_millis(delay_ms));
         child.kill().unwrap(); // SIGKILL
         child.wait().unwrap();
         let state = d
@@ -182,7 +186,9 @@ fn resuming_after_sigkill_gives_the_uninterrupted_image() {
             .exists()
             .then(|| read(&d.join("out.exr")).accumulation.count);
         eprintln!("round {round}: killed after {delay_ms} ms, the file holds {state:?} spp");
+        killed_mid_render |= state.is_none_or(|n| n < 2048);
     }
+    assert!(killed_mid_render, "both renders finished before the kill");
     let mut command = render_command(d, &spp);
     command.args(["-o", "out.exr"]);
     if d.join("out.exr").exists() {
@@ -195,7 +201,7 @@ fn resuming_after_sigkill_gives_the_uninterrupted_image() {
         String::from_utf8_lossy(&out.stderr)
     );
     let resumed = read(&d.join("out.exr"));
-    assert_eq!(resumed.info.ranges, vec![0..256]);
+    assert_eq!(resumed.info.ranges, vec![0..2048]);
     let worst = common::merge_bound::worst_vs_bound(&resumed.accumulation, &single.accumulation);
     eprintln!("largest |resumed − uninterrupted| is {worst:.2e} of the bound");
     assert!(worst <= 1.0, "resumed differs by {worst} × the bound");
