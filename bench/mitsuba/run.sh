@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# Interleaved side by side: glint on the GPU (lavapipe here), glint's CPU reference, and
+# Mitsuba 3 (compare.py), on the same scene, resolution, spp and depth; prints the medians.
+#
+#   bench/mitsuba/run.sh [SCENE]            (default scenes/cornell.toml)
+#
+# Environment: ROUNDS (5), WIDTH and HEIGHT (256), SPP (64), BOUNCES (8), OUT (a new
+# folder under /tmp), GLINT (target/release/glint), DEVICES ("gpu cpu mitsuba"),
+# DRJIT_LIBLLVM_PATH (see README.md). Light sampling is glint's default (on); Mitsuba's path
+# integrator always samples emitters.
+set -euo pipefail
+
+here=$(cd "$(dirname "$0")" && pwd)
+scene=${1:-scenes/cornell.toml}
+rounds=${ROUNDS:-5}
+width=${WIDTH:-256}
+height=${HEIGHT:-256}
+spp=${SPP:-64}
+bounces=${BOUNCES:-8}
+glint=${GLINT:-target/release/glint}
+devices=${DEVICES:-gpu cpu mitsuba}
+out=${OUT:-$(mktemp -d /tmp/glint-vs-mitsuba.XXXXXX)}
+mkdir -p "$out"
+
+# lavapipe wants a private runtime folder and a writable shader cache (see README.md).
+export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-$USER}
+mkdir -p -m 700 "$XDG_RUNTIME_DIR"
+export MESA_SHADER_CACHE_DIR=${MESA_SHADER_CACHE_DIR:-$PWD/target/mesa-shader-cache}
+
+if [[ " $devices " == *" mitsuba "* && -z "${DRJIT_LIBLLVM_PATH:-}" ]]; then
+    echo "run.sh: DRJIT_LIBLLVM_PATH is not set; Mitsuba's LLVM variant needs libLLVM >= 16" \
+        "(see bench/mitsuba/README.md)" >&2
+    exit 2
+fi
+if [[ " $devices " == *" gpu "* || " $devices " == *" cpu "* ]] && [[ ! -x "$glint" ]]; then
+    echo "run.sh: $glint not found; run cargo build --release first" >&2
+    exit 2
+fi
+
+common=(--width "$width" --height "$height" --spp "$spp" --max-bounces "$bounces")
+results="$out/results.jsonl"
+: > "$results"
+echo "scene $scene, ${width}x${height}, $spp spp, max_bounces $bounces, $rounds rounds; files in $out" >&2
+for round in $(seq 1 "$rounds"); do
+    for device in $devices; do
+        case $device in
+        gpu | cpu)
+            line=$("$glint" render "$scene" "${common[@]}" --"$device" --seed "$round" \
+                -o "$out/glint-$device.exr" --json)
+            ;;
+        mitsuba)
+            # One warm-up render (JIT compilation, not timed), then one timed render.
+            line=$(python3 "$here/compare.py" "$scene" "${common[@]}" --seed "$round" --runs 1 \
+                -o "$out/mitsuba.exr" --png "$out/mitsuba.png")
+            ;;
+        *)
+            echo "run.sh: unknown device $device" >&2
+            exit 2
+            ;;
+        esac
+        echo "{\"round\": $round, \"device\": \"$device\", \"result\": $line}" >> "$results"
+        echo "round $round $device: $(python3 -c 'import json,sys; print(f"{json.loads(sys.argv[1])["paths_per_second"]/1e6:.3f} M paths/s")' "$line")" >&2
+    done
+done
+
+python3 - "$results" <<'EOF'
+import json, statistics, sys
+rows = [json.loads(l) for l in open(sys.argv[1])]
+names = {"gpu": "glint GPU", "cpu": "glint CPU reference", "mitsuba": "Mitsuba 3"}
+per = {}
+for r in rows:
+    per.setdefault(r["device"], []).append(r["result"]["paths_per_second"])
+print("| renderer | median paths/s | runs (interleaved, M paths/s) |")
+print("|---|---|---|")
+for device, values in per.items():
+    label = names[device]
+    if device == "gpu":
+        label += f" ({rows[[r['device'] for r in rows].index('gpu')]['result']['device']})"
+    if device == "mitsuba":
+        first = next(r["result"] for r in rows if r["device"] == "mitsuba")
+        label += f" {first['mitsuba']} {first['variant']}, {first['threads']} threads"
+    runs = " / ".join(f"{v / 1e6:.2f}" for v in values)
+    print(f"| {label} | {statistics.median(values) / 1e6:.2f} M | {runs} |")
+if "mitsuba" in per:
+    m = statistics.median(per["mitsuba"])
+    for device in ("gpu", "cpu"):
+        if device in per:
+            print(f"{names[device]} / Mitsuba 3: {statistics.median(per[device]) / m:.2f}x")
+EOF
+
+# The images should agree (same scene): means per channel, Mitsuba against glint.
+if [[ " $devices " == *" mitsuba "* ]]; then
+    for device in gpu cpu; do
+        if [[ -f "$out/glint-$device.exr" ]]; then
+            echo "Mitsuba (A) against glint $device (B), last round:"
+            "$glint" compare "$out/mitsuba.exr" "$out/glint-$device.exr" | grep -E '^(mean|RMSE|rel)'
+        fi
+    done
+fi
