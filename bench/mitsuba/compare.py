@@ -23,6 +23,9 @@ import tomllib
 # ROULETTE_START_BOUNCE in src/scene/mod.rs); Mitsuba plays it once depth >= rr_depth, with
 # depth counted after the event, so rr_depth = 3 + 1.
 GLINT_ROULETTE_START_BOUNCE = 3
+# glint's emitters emit from both sides; Mitsuba's from the front. Emitting quads and spheres
+# get a back-facing twin this far behind them, relative to their size.
+TWIN_OFFSET = 1e-4
 
 
 class ConversionError(Exception):
@@ -276,18 +279,33 @@ def convert_scene(scene_path, overrides):
         where = f"spheres[{i}]"
         check_keys(s, ["center", "radius", "material"], where)
         radius = number(s["radius"], f"{where}.radius")
-        out[f"sphere_{i}"] = attach(
-            {"type": "sphere", "center": vec3(s["center"], f"{where}.center"), "radius": radius},
-            material_of(s, where), 4 * math.pi * radius * radius)
+        center = vec3(s["center"], f"{where}.center")
+        material = material_of(s, where)
+        out[f"sphere_{i}"] = attach({"type": "sphere", "center": center, "radius": radius},
+                                    material, 4 * math.pi * radius * radius)
+        if material[1] is not None:
+            # glint's emitters emit from both sides, Mitsuba's area lights from the front
+            # only: a slightly smaller twin facing inwards emits into the sphere.
+            out[f"sphere_{i}_inside"] = attach(
+                {"type": "sphere", "center": center, "radius": radius * (1 - TWIN_OFFSET),
+                 "flip_normals": True}, material, 4 * math.pi * radius * radius)
         counts["spheres"] += 1
     for i, q in enumerate(scene.get("quads", [])):
         where = f"quads[{i}]"
         check_keys(q, ["corner", "u", "v", "material"], where)
         matrix, area = quad_to_world(vec3(q["corner"], f"{where}.corner"),
                                      vec3(q["u"], f"{where}.u"), vec3(q["v"], f"{where}.v"), where)
-        out[f"quad_{i}"] = attach(
-            {"type": "rectangle", "to_world": mi.ScalarTransform4f(matrix)},
-            material_of(q, where), area)
+        material = material_of(q, where)
+        to_world = mi.ScalarTransform4f(matrix)
+        out[f"quad_{i}"] = attach({"type": "rectangle", "to_world": to_world}, material, area)
+        if material[1] is not None:
+            # Back-side emission (see spheres): a twin facing the other way, moved behind
+            # the quad by a hair; turning y and z over keeps the frame right-handed.
+            behind = -TWIN_OFFSET * math.sqrt(area)
+            flip = [[1.0, 0, 0, 0], [0, -1.0, 0, 0], [0, 0, -1.0, behind], [0, 0, 0, 1.0]]
+            out[f"quad_{i}_back"] = attach(
+                {"type": "rectangle", "to_world": to_world @ mi.ScalarTransform4f(flip)},
+                material, area)
         counts["quads"] += 1
     for i, mesh in enumerate(scene.get("meshes", [])):
         where = f"meshes[{i}]"
@@ -319,6 +337,9 @@ def convert_scene(scene_path, overrides):
                 raise ConversionError(f"{where}.file: {path}: Mitsuba cannot read it: {e}")
             area = float(area[0] if hasattr(area, "__len__") else area)
         out[f"mesh_{i}"] = attach(shape, material, area)
+        if material[1] is not None:
+            print(f"compare.py: warning: {where}: Mitsuba's area lights emit on the front "
+                  "side only (the triangles' winding); glint's emit on both", file=sys.stderr)
         counts["meshes"] += 1
 
     summary = {"width": width, "height": height, "spp": spp, "max_bounces": max_bounces,

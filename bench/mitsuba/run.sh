@@ -23,7 +23,7 @@ out=${OUT:-$(mktemp -d /tmp/glint-vs-mitsuba.XXXXXX)}
 mkdir -p "$out"
 
 # lavapipe wants a private runtime folder and a writable shader cache (see README.md).
-export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-$USER}
+export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-$(id -un)}
 mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 export MESA_SHADER_CACHE_DIR=${MESA_SHADER_CACHE_DIR:-$PWD/target/mesa-shader-cache}
 
@@ -58,8 +58,10 @@ for round in $(seq 1 "$rounds"); do
             exit 2
             ;;
         esac
-        echo "{\"round\": $round, \"device\": \"$device\", \"result\": $line}" >> "$results"
-        echo "round $round $device: $(python3 -c 'import json,sys; print(f"{json.loads(sys.argv[1])["paths_per_second"]/1e6:.3f} M paths/s")' "$line")" >&2
+        # The load average tells how busy the shared machine was.
+        load=$(cut -d' ' -f1 /proc/loadavg)
+        echo "{\"round\": $round, \"device\": \"$device\", \"load\": $load, \"result\": $line}" >> "$results"
+        echo "round $round $device (load $load): $(python3 -c 'import json,sys; print("%.3f M paths/s" % (json.loads(sys.argv[1])["paths_per_second"] / 1e6))' "$line")" >&2
     done
 done
 
@@ -81,6 +83,8 @@ for device, values in per.items():
         label += f" {first['mitsuba']} {first['variant']}, {first['threads']} threads"
     runs = " / ".join(f"{v / 1e6:.2f}" for v in values)
     print(f"| {label} | {statistics.median(values) / 1e6:.2f} M | {runs} |")
+loads = [r["load"] for r in rows]
+print(f"1-minute load average during the runs: {min(loads):.1f} to {max(loads):.1f} (2 cores)")
 if "mitsuba" in per:
     m = statistics.median(per["mitsuba"])
     for device in ("gpu", "cpu"):
