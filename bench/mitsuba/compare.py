@@ -394,15 +394,19 @@ def main():
     if jit:
         dr.set_flag(dr.JitFlag.KernelHistory, True)
 
+    cpu_seconds = []  # process CPU time (all threads) of each render
+
     def render(seed):
-        """Wall seconds of one render, and the seconds its kernels ran (JIT variants)."""
+        """Wall seconds of one render, and the seconds its kernels ran (JIT variants); appends
+        its CPU seconds to cpu_seconds."""
         if jit:
             dr.kernel_history()  # clear
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         image = mi.render(scene, seed=seed, spp=summary["spp"])
         dr.eval(image)
         dr.sync_thread()
         seconds = time.perf_counter() - start
+        cpu_seconds.append(time.process_time() - cpu_start)
         kernel_seconds, compiled = None, False
         if jit:
             history = [k for k in dr.kernel_history() if "execution_time" in k]
@@ -448,6 +452,9 @@ def main():
         "seconds": seconds,
         "seconds_median": median,
         "paths_per_second": paths / median,
+        # Process CPU time (user + sys, all threads) of a timed render, per path: less
+        # disturbed than wall time by other processes on shared cores.
+        "cpu_seconds_per_path": statistics.median(cpu_seconds[1:]) / paths,
         "kernel_seconds_median": statistics.median(kernel_seconds) if kernel_seconds else None,
         "paths_per_second_kernel": paths / statistics.median(kernel_seconds)
         if kernel_seconds else None,

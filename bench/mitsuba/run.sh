@@ -45,8 +45,19 @@ for round in $(seq 1 "$rounds"); do
     for device in $devices; do
         case $device in
         gpu | cpu)
-            line=$("$glint" render "$scene" "${common[@]}" --"$device" --seed "$round" \
-                -o "$out/glint-$device.exr" --json)
+            # Process CPU time (user + sys) at $spp and at 1 spp: their difference is the CPU
+            # time of spp - 1 samples per pixel without start-up and shader compilation, a
+            # measure that other processes on the shared cores disturb less than wall time.
+            /usr/bin/time -f '%U %S' -o "$out/time-1spp" "$glint" render "$scene" \
+                --width "$width" --height "$height" --spp 1 --max-bounces "$bounces" \
+                --"$device" --seed "$round" -o "$out/glint-$device-1spp.exr" > /dev/null
+            /usr/bin/time -f '%U %S' -o "$out/time" "$glint" render "$scene" "${common[@]}" \
+                --"$device" --seed "$round" -o "$out/glint-$device.exr" --json > "$out/line"
+            line=$(python3 -c 'import json, sys
+line = json.load(open(sys.argv[1]))
+cpu = lambda f: sum(map(float, open(f).read().split()))
+line["cpu_seconds_per_path"] = (cpu(sys.argv[2]) - cpu(sys.argv[3])) / (line["paths"] * (1 - 1 / line["spp"]))
+print(json.dumps(line))' "$out/line" "$out/time" "$out/time-1spp")
             ;;
         mitsuba)
             # One warm-up render (JIT compilation, not timed), then one timed render.
@@ -69,11 +80,14 @@ python3 - "$results" <<'EOF'
 import json, statistics, sys
 rows = [json.loads(l) for l in open(sys.argv[1])]
 names = {"gpu": "glint GPU", "cpu": "glint CPU reference", "mitsuba": "Mitsuba 3"}
-per = {}
+per, per_cpu = {}, {}
 for r in rows:
     per.setdefault(r["device"], []).append(r["result"]["paths_per_second"])
-print("| renderer | median paths/s | runs (interleaved, M paths/s) |")
-print("|---|---|---|")
+    # Too small a render to measure CPU time by difference gives 0 or less: not a number.
+    cost = r["result"]["cpu_seconds_per_path"]
+    per_cpu.setdefault(r["device"], []).append(1 / cost if cost > 0 else float("nan"))
+print("| renderer | median paths/s | runs (interleaved, M paths/s) | median paths per CPU second |")
+print("|---|---|---|---|")
 for device, values in per.items():
     label = names[device]
     if device == "gpu":
@@ -82,14 +96,16 @@ for device, values in per.items():
         first = next(r["result"] for r in rows if r["device"] == "mitsuba")
         label += f" {first['mitsuba']} {first['variant']}, {first['threads']} threads"
     runs = " / ".join(f"{v / 1e6:.2f}" for v in values)
-    print(f"| {label} | {statistics.median(values) / 1e6:.2f} M | {runs} |")
+    cpu = statistics.median(per_cpu[device])
+    print(f"| {label} | {statistics.median(values) / 1e6:.2f} M | {runs} | {cpu / 1e6:.2f} M |")
 loads = [r["load"] for r in rows]
 print(f"1-minute load average during the runs: {min(loads):.1f} to {max(loads):.1f} (2 cores)")
 if "mitsuba" in per:
     m = statistics.median(per["mitsuba"])
     for device in ("gpu", "cpu"):
         if device in per:
-            print(f"{names[device]} / Mitsuba 3: {statistics.median(per[device]) / m:.2f}x")
+            print(f"{names[device]} / Mitsuba 3: {statistics.median(per[device]) / m:.2f}x "
+                  f"(per CPU second: {statistics.median(per_cpu[device]) / statistics.median(per_cpu['mitsuba']):.2f}x)")
 EOF
 
 # The images should agree (same scene): means per channel, Mitsuba against glint.
