@@ -10,6 +10,7 @@ interleaved comparison with glint.
 """
 
 import argparse
+import cmath
 import json
 import math
 import os
@@ -134,6 +135,35 @@ def file_has_normals(path, ext):
     return False
 
 
+def conductor_fresnel(cos_i, eta, k):
+    """Unpolarised Fresnel reflectance of a conductor with IOR eta + ik, from vacuum."""
+    n = complex(eta, k)
+    cos_t = cmath.sqrt(1 - (1 - cos_i * cos_i) / (n * n))
+    r_s = (cos_i - n * cos_t) / (cos_i + n * cos_t)
+    r_p = (n * cos_i - cos_t) / (n * cos_i + cos_t)
+    return (abs(r_s) ** 2 + abs(r_p) ** 2) / 2
+
+
+def conductor_ior_for_schlick(f0):
+    """(eta, k) whose Fresnel curve is f0 head-on and closest to Schlick's
+    f0 + (1 - f0)(1 - cos)^5 elsewhere (least squares weighted by cos, over eta in
+    (0, 4]; k follows from f0 and eta). Within 0.005 of Schlick for f0 >= 0.75 and 0.03
+    for darker channels."""
+    f0 = min(max(f0, 0.0), 0.9999)
+    cosines = [(i + 0.5) / 64 for i in range(64)]
+    best = (math.inf, 1.0, 0.0)
+    for step in range(1, 401):
+        eta = step * 0.01
+        k2 = (f0 * (eta + 1) ** 2 - (eta - 1) ** 2) / (1 - f0)
+        if k2 < 0:
+            continue
+        k = math.sqrt(k2)
+        error = sum(c * (conductor_fresnel(c, eta, k) - f0 - (1 - f0) * (1 - c) ** 5) ** 2
+                    for c in cosines)
+        best = min(best, (error, eta, k))
+    return best[1], best[2]
+
+
 def rgb(value):
     return {"type": "rgb", "value": value}
 
@@ -152,17 +182,15 @@ def convert_material(name, m):
         bsdf = {"type": "conductor", "material": "none",
                 "specular_reflectance": rgb(vec3(m["color"], f"{where}.color"))}
     elif kind == "metal":
-        # glint: GGX with Schlick Fresnel, F0 = color. Mitsuba's conductors take a complex
-        # IOR; material "none" (F = 1) times specular_reflectance = color gives F ≡ F0, which
-        # misses Schlick's brightening towards grazing angles (an approximation).
+        # glint: GGX with Schlick's Fresnel, F0 = color. Mitsuba's conductors take a complex
+        # IOR: per channel, the one that gives F0 head-on and follows Schlick's curve closest.
         check_keys(m, common + ["color", "roughness"], where)
         roughness = number(m["roughness"], f"{where}.roughness")
-        color = rgb(vec3(m["color"], f"{where}.color"))
-        if roughness == 0:
-            bsdf = {"type": "conductor", "material": "none", "specular_reflectance": color}
-        else:
-            bsdf = {"type": "roughconductor", "distribution": "ggx", "material": "none",
-                    "alpha": roughness * roughness, "specular_reflectance": color}
+        fits = [conductor_ior_for_schlick(f0) for f0 in vec3(m["color"], f"{where}.color")]
+        bsdf = {"type": "conductor", "eta": rgb([f[0] for f in fits]),
+                "k": rgb([f[1] for f in fits])}
+        if roughness > 0:
+            bsdf.update(type="roughconductor", distribution="ggx", alpha=roughness * roughness)
     elif kind == "dielectric":
         check_keys(m, common + ["ior", "color"], where)
         bsdf = {"type": "dielectric", "int_ior": number(m["ior"], f"{where}.ior"),
@@ -361,10 +389,17 @@ def main():
     parser.add_argument("--threads", type=int, help="Dr.Jit's thread pool size (default: all)")
     parser.add_argument("-o", "--output", help="EXR of the warm-up render (linear float32)")
     parser.add_argument("--png", help="PNG of the warm-up render (clamped, sRGB)")
+    parser.add_argument("--variance", metavar="FILE.exr",
+                        help="write to -o the mean of all runs + 1 renders (independent seeds) "
+                        "instead of the warm-up render, and here the variance of that mean per "
+                        "pixel (σ²/n, estimated from the spread between the renders), for "
+                        "glint compare's Z-test; needs --runs >= 1 and -o")
     args = parser.parse_args()
+    if args.variance is not None and args.output is None:
+        fail("--variance: needs -o")
     if args.runs < 1:
         fail("--runs: must be >= 1")
-    for path, ext in [(args.output, ".exr"), (args.png, ".png")]:
+    for path, ext in [(args.output, ".exr"), (args.png, ".png"), (args.variance, ".exr")]:
         if path is not None and not path.lower().endswith(ext):
             fail(f"{path}: expected a {ext} file name")
 
@@ -422,7 +457,9 @@ def main():
 
     image, warm_seconds, _, _ = render(summary["seed"])
     means = [channel_means(image)]
-    if args.output:
+    # Welford's running mean and sum of squared deviations over the renders, per pixel.
+    mean_image, m2_image = image, dr.zeros(mi.TensorXf, image.shape)
+    if args.output and args.variance is None:
         mi.Bitmap(image).write(args.output)
     if args.png:
         mi.Bitmap(image).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8,
@@ -433,10 +470,19 @@ def main():
         # A new seed per run, as glint's timed batches draw new samples.
         timed_image, s, k, compiled = render(summary["seed"] + 1 + run)
         means.append(channel_means(timed_image))
+        if args.variance is not None:
+            delta = timed_image - mean_image
+            mean_image = mean_image + delta / len(means)
+            m2_image = m2_image + delta * (timed_image - mean_image)
+            dr.eval(mean_image, m2_image)
         seconds.append(s)
         if k is not None:
             kernel_seconds.append(k)
         recompiled += compiled
+    if args.variance is not None:
+        k = len(means)
+        mi.Bitmap(mean_image).write(args.output)
+        mi.Bitmap(m2_image / (k * (k - 1))).write(args.variance)
     paths = summary["width"] * summary["height"] * summary["spp"]
     median = statistics.median(seconds)
     result = {
