@@ -3,7 +3,9 @@
 
 Builds the equivalent Mitsuba scene dict, renders once to warm up (JIT compilation is not
 timed), then times N renders and prints one JSON line with the medians. Writes the warm-up
-image as a linear float32 EXR (for `glint compare`) and optionally as an sRGB PNG.
+image as a linear float32 EXR (for `glint compare`) and optionally as an sRGB PNG; with
+--variance, the mean of all the renders and the variance of that mean per pixel instead, for
+glint compare's per-pixel Z-test.
 
 See README.md in this folder for the mapping and its approximations, and run.sh for the
 interleaved comparison with glint.
