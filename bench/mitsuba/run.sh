@@ -28,8 +28,8 @@ mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 export MESA_SHADER_CACHE_DIR=${MESA_SHADER_CACHE_DIR:-$PWD/target/mesa-shader-cache}
 
 if [[ " $devices " == *" mitsuba "* && -z "${DRJIT_LIBLLVM_PATH:-}" ]]; then
-    echo "run.sh: DRJIT_LIBLLVM_PATH is not set; Mitsuba's LLVM variant needs libLLVM >= 16" \
-        "(see bench/mitsuba/README.md)" >&2
+    echo "run.sh: DRJIT_LIBLLVM_PATH is not set; Mitsuba's LLVM variant crashes with LLVM 15:" \
+        "point it at libLLVM-19.so (see bench/mitsuba/README.md)" >&2
     exit 2
 fi
 if [[ " $devices " == *" gpu "* || " $devices " == *" cpu "* ]] && [[ ! -x "$glint" ]]; then
