@@ -19,8 +19,6 @@ spp=${SPP:-64}
 bounces=${BOUNCES:-8}
 glint=${GLINT:-target/release/glint}
 devices=${DEVICES:-gpu cpu mitsuba}
-out=${OUT:-$(mktemp -d /tmp/glint-vs-mitsuba.XXXXXX)}
-mkdir -p "$out"
 
 # lavapipe wants a private runtime folder and a writable shader cache (see README.md).
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-$(id -un)}
@@ -36,6 +34,9 @@ if [[ " $devices " == *" gpu "* || " $devices " == *" cpu "* ]] && [[ ! -x "$gli
     echo "run.sh: $glint not found; run cargo build --release first" >&2
     exit 2
 fi
+
+out=${OUT:-$(mktemp -d /tmp/glint-vs-mitsuba.XXXXXX)}
+mkdir -p "$out"
 
 common=(--width "$width" --height "$height" --spp "$spp" --max-bounces "$bounces")
 results="$out/results.jsonl"
