@@ -3,8 +3,10 @@
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
-use crate::output::{check_output_path, ImageFormat};
-use crate::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
+use crate::output_check::OutputSet;
+use crate::render::{
+    relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
+};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -51,15 +53,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub gpu: bool,
     /// Stop at the first batch boundary after this many seconds and write what is done.
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
     /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr.
     #[arg(long, value_name = "FILE.exr")]
     pub variance: Option<PathBuf>,
     /// Stop at the first batch boundary where the image's relative standard error,
     /// √(mean of the variance image) / (mean of the image), is at most E (checked from 8 spp on).
-    /// --spp is then the upper bound, and --time-limit still holds.
-    #[arg(long, value_name = "E", value_parser = parse_target_error)]
+    /// --spp is then the upper bound, and --time-limit still holds. On a black image (mean 0)
+    /// the relative error is undefined, so it never stops the render (a note says so).
+    #[arg(long, value_name = "E", value_parser = parse_target_error, allow_negative_numbers = true)]
     pub target_error: Option<f64>,
     /// Print a JSON summary on stdout at the end. Its "seconds" is the time spent rendering
     /// batches only: start-up, scene upload, shader compilation and file writes are not in it
@@ -68,12 +71,17 @@ pub struct RenderArgs {
     pub json: bool,
 }
 
+/// Longest `--time-limit`: about 31 years, far inside what a `Duration` holds (1.8e19 s).
+const MAX_TIME_LIMIT_SECONDS: f64 = 1e9;
+
 fn parse_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .parse()
         .map_err(|_| format!("{s:?} is not a number of seconds"))?;
-    if !v.is_finite() || v < 0.0 {
-        return Err(format!("must be a finite number ≥ 0, got {s}"));
+    if !(0.0..=MAX_TIME_LIMIT_SECONDS).contains(&v) {
+        return Err(format!(
+            "must be a number of seconds in [0, {MAX_TIME_LIMIT_SECONDS:e}], got {s}"
+        ));
     }
     Ok(v)
 }
@@ -108,7 +116,7 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
         Ok(ctx) => Ok(Some(ctx)),
         Err(e) if args.gpu => Err(anyhow::Error::new(e).context("--gpu was given")),
         Err(e) => {
-            eprintln!("glint: {e}; rendering on the CPU reference instead");
+            crate::errln!("glint: {e}; rendering on the CPU reference instead");
             Ok(None)
         }
     }
@@ -132,17 +140,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.scene));
-    check_output_path(&output).map_err(InputError)?;
-    if let Some(variance) = &args.variance {
-        check_output_path(variance).map_err(InputError)?;
-        if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
-            return Err(InputError(format!(
-                "{}: --variance needs an .exr file (linear floats)",
-                variance.display()
-            ))
-            .into());
-        }
-    }
+    OutputSet::new()
+        .input("the scene file", &args.scene)
+        .image("-o", &output)
+        .exr_opt("--variance", args.variance.as_deref())
+        .check()?;
 
     let kernel_scene = scene.kernel_scene();
     let gpu = open_gpu(&args)?;
@@ -192,6 +194,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
         },
     )?;
     progress.finish_and_clear();
+    if args.target_error.is_some() && stats.relative_error.is_none() {
+        crate::errln!(
+            "glint: note: --target-error never applied: the image is black (or below {MIN_SPP_FOR_TARGET_ERROR} spp), so its relative error is undefined"
+        );
+    }
     let mean = renderer.read_mean()?;
     let variance = renderer.read_variance()?;
     mean.write(&output)
@@ -218,11 +225,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "paths_per_second": paths as f64 / seconds.max(1e-9),
             "wall_seconds": started.elapsed().as_secs_f64(),
             "stopped_by": stats.stop_reason.as_str(),
-            "relative_error": relative_error(&mean, &variance),
+            // Below 2 spp there is no variance estimate: the error is unknown (null), not 0.
+            "relative_error": (stats.spp >= 2).then(|| relative_error(&mean, &variance)).flatten(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
         });
-        println!("{summary}");
+        crate::outln!("{summary}");
     }
     Ok(())
 }

@@ -199,7 +199,7 @@ impl<'a> GpuRenderer<'a> {
             RENDER_ENTRY_POINT,
         );
         ctx.wait_idle()?;
-        Ok(GpuRenderer {
+        let renderer = GpuRenderer {
             ctx,
             variant,
             pipeline,
@@ -212,7 +212,31 @@ impl<'a> GpuRenderer<'a> {
             samples: 0,
             counter_buffer,
             instruments: None,
-        })
+        };
+        renderer.warm_up()?;
+        Ok(renderer)
+    }
+
+    /// Runs the kernel once, on one workgroup and with no samples (it returns at once, leaving
+    /// the image untouched), so the driver finishes compiling it now: lavapipe compiles at the
+    /// first dispatch (about 1 s with a cold Mesa cache), which would otherwise count as
+    /// render time.
+    fn warm_up(&self) -> Result<()> {
+        let params = Params {
+            sample_count: 0,
+            ..self.params
+        };
+        let queue = &self.ctx.queue;
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        queue.submit([encoder.finish()]);
+        self.ctx.wait_idle()
     }
 
     /// Turns on benchmark instrumentation: after every batch, the renderer reads back the

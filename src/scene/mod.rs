@@ -13,6 +13,7 @@ mod validate;
 
 pub use kernel::KernelScene;
 
+use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
 use glam::Vec3;
 use std::ops::Range;
@@ -167,11 +168,13 @@ pub struct RenderOverrides {
 impl Scene {
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let bytes = std::fs::read(path).map_err(|e| SceneError {
-            path: path.to_owned(),
-            position: None,
-            field: None,
-            message: format!("cannot read the scene file: {e}"),
+        let bytes = read_regular_file(path, SCENE_FILE_LIMIT, "scene file").map_err(|message| {
+            SceneError {
+                path: path.to_owned(),
+                position: None,
+                field: None,
+                message,
+            }
         })?;
         let text = String::from_utf8(bytes).map_err(|e| SceneError {
             path: path.to_owned(),
