@@ -202,6 +202,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
 
+    let nonfinite = renderer.nonfinite_samples();
+    if nonfinite > 0 {
+        eprintln!(
+            "glint: warning: {nonfinite} samples were NaN, infinite or above 1e14 and were \
+             dropped (counted as black)"
+        );
+    }
     if args.json {
         let seconds = stats.render_time.as_secs_f64();
         let paths = pixels as u64 * stats.spp as u64;
@@ -219,6 +226,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "wall_seconds": started.elapsed().as_secs_f64(),
             "stopped_by": stats.stop_reason.as_str(),
             "relative_error": relative_error(&mean, &variance),
+            "nonfinite_samples": renderer.nonfinite_samples(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
         });
