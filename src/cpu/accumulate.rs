@@ -43,7 +43,7 @@ pub fn accumulator_start(count: u32, mean: Vec3, m2: Vec3) -> Accumulator {
 /// Whether a block of the merge schedule ends once a pixel has `samples` samples (≥ 1).
 pub fn is_block_end(samples: u32) -> bool {
     if samples >= MERGE_BLOCK {
-        return samples % MERGE_BLOCK == 0;
+        return samples.is_multiple_of(MERGE_BLOCK);
     }
     samples & (samples - 1) == 0
 }
@@ -93,7 +93,7 @@ pub fn merge_block(acc: &mut Accumulator) {
     let n_new = acc.block_count as f32;
     let n = n_old + n_new;
     let delta = acc.block_mean - acc.mean;
-    acc.mean = acc.mean + delta * (n_new / n);
+    acc.mean += delta * (n_new / n);
     acc.m2 = acc.m2 + acc.block_m2 + delta * delta * (n_old * n_new / n);
     acc.count += acc.block_count;
     acc.block_count = 0;
