@@ -61,7 +61,11 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
-/// A display byte: clamped to [0, 1], sRGB-encoded, rounded. NaN shows as black.
+/// How a pixel with a NaN channel shows in a PNG: magenta.
+pub const NAN_PIXEL: [u8; 3] = [255, 0, 255];
+
+/// A display byte: clamped to [0, 1], sRGB-encoded, rounded. NaN shows as black here; whole
+/// images mark NaN pixels with [`NAN_PIXEL`] instead ([`Image::to_srgb8`]).
 pub fn srgb_byte(linear: f32) -> u8 {
     let clamped = if linear.is_nan() {
         0.0
@@ -72,8 +76,20 @@ pub fn srgb_byte(linear: f32) -> u8 {
 }
 
 impl Image {
+    /// Display bytes; a pixel with a NaN channel shows as magenta, never as black, so that a
+    /// broken pixel cannot pass for a dark one (renders never produce NaN: see
+    /// `shaders/accumulate.wgsl`).
     pub fn to_srgb8(&self) -> Vec<u8> {
-        self.pixels.iter().flat_map(|p| p.map(srgb_byte)).collect()
+        self.pixels
+            .iter()
+            .flat_map(|p| {
+                if p.iter().any(|c| c.is_nan()) {
+                    NAN_PIXEL
+                } else {
+                    p.map(srgb_byte)
+                }
+            })
+            .collect()
     }
 
     /// Writes the image atomically (see [`crate::atomic_write`]); the format comes from the

@@ -2,6 +2,7 @@
 //! each submission stays short (a real GPU's watchdog kills long ones), until the sample
 //! count or the time limit is reached.
 
+use crate::cpu::accumulate::next_block_end;
 use crate::output::Image;
 use anyhow::Result;
 use std::time::{Duration, Instant};
@@ -30,6 +31,9 @@ pub trait Renderer {
     fn last_kernel_time(&self) -> Option<Duration> {
         None
     }
+    /// Samples dropped since the last reset because they were NaN, infinite or too large
+    /// (`shaders/accumulate.wgsl`); each counted as black.
+    fn nonfinite_samples(&self) -> u64;
     /// Adapter name, or "cpu".
     fn device_name(&self) -> String;
     fn backend_name(&self) -> String;
@@ -150,7 +154,10 @@ pub fn render_progressive(
     let mut stop_reason = StopReason::SamplesReached;
     let mut error = None;
     while renderer.samples() < spp {
-        let count = sizer.spp_per_batch.min(spp - renderer.samples());
+        // Batches end only where the merge schedule's blocks do, so the image's bytes do not
+        // depend on the batch sizes, which follow the wall clock (src/cpu/accumulate.rs).
+        let done = renderer.samples();
+        let count = next_block_end(done, sizer.spp_per_batch, spp) - done;
         let batch_start = Instant::now();
         renderer.add_samples(count)?;
         let took = batch_start.elapsed();
@@ -196,11 +203,13 @@ pub fn render_progressive(
     })
 }
 
-/// Adds samples until there are `spp`, in batches of `batch`, and returns the mean image: the
+/// Adds samples until there are `spp`, in batches of about `batch` (rounded up to the merge
+/// schedule's block ends, like [`render_progressive`]'s), and returns the mean image: the
 /// simple path for tests and tools that want no progress reporting.
 pub fn render_image(renderer: &mut dyn Renderer, spp: u32, batch: u32) -> Result<Image> {
     while renderer.samples() < spp {
-        renderer.add_samples(batch.max(1).min(spp - renderer.samples()))?;
+        let done = renderer.samples();
+        renderer.add_samples(next_block_end(done, batch, spp) - done)?;
     }
     renderer.read_mean()
 }

@@ -209,6 +209,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
 
+    let nonfinite = renderer.nonfinite_samples();
+    if nonfinite > 0 {
+        crate::errln!(
+            "glint: warning: {nonfinite} samples were NaN, infinite or above 1e14 and were \
+             dropped (counted as black)"
+        );
+    }
     if args.json {
         let seconds = stats.render_time.as_secs_f64();
         let paths = pixels as u64 * stats.spp as u64;
@@ -227,6 +234,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "stopped_by": stats.stop_reason.as_str(),
             // Below 2 spp there is no variance estimate: the error is unknown (null), not 0.
             "relative_error": (stats.spp >= 2).then(|| relative_error(&mean, &variance)).flatten(),
+            "nonfinite_samples": renderer.nonfinite_samples(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
         });

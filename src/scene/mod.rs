@@ -9,6 +9,7 @@
 
 mod file;
 mod kernel;
+pub mod limits;
 mod validate;
 
 pub use kernel::KernelScene;
@@ -93,12 +94,14 @@ pub struct CameraBasis {
 
 impl Camera {
     pub fn basis(&self) -> CameraBasis {
-        let w = (self.eye - self.target).normalize();
-        let right = self.up.cross(w).normalize();
+        // In f64: the squares of a short `up` (1e-25) or of a cross product of nearly
+        // parallel vectors underflow in f32, and normalising them would give NaN.
+        let w = (self.eye.as_dvec3() - self.target.as_dvec3()).normalize();
+        let right = self.up.as_dvec3().cross(w).normalize();
         CameraBasis {
-            w,
-            right,
-            image_up: w.cross(right),
+            w: w.as_vec3(),
+            right: right.as_vec3(),
+            image_up: w.cross(right).as_vec3(),
         }
     }
 }
