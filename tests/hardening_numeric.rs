@@ -430,6 +430,12 @@ fn batching_and_tiling_do_not_change_a_single_bit() {
         whole == tiled_image,
         "GPU, tiles of one workgroup and batches of 3"
     );
+    // On lavapipe this scene's batches are split into dispatches of 2 samples (its loop
+    // limit); the split follows the sample indices, not the batches.
+    let spheres = box_of_spheres(2049, 8);
+    let one = render_image(&mut GpuRenderer::new(ctx, &spheres).unwrap(), 8, 1).unwrap();
+    let all = render_image(&mut GpuRenderer::new(ctx, &spheres).unwrap(), 8, 8).unwrap();
+    assert!(one == all, "GPU, 2049 spheres, batches of 1 and of 8");
 }
 
 // ---- 15: the device's limits ----

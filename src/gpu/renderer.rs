@@ -508,15 +508,20 @@ impl<'a> GpuRenderer<'a> {
 
 impl Renderer for GpuRenderer<'_> {
     fn add_samples(&mut self, count: u32) -> Result<()> {
-        // Dispatches of at most this many samples stay within lavapipe's loop limit.
+        // Dispatches of at most this many samples stay within lavapipe's loop limit. They end
+        // at multiples of a power of two of samples, fixed by the scene and the device, so
+        // where the kernel merges (shaders/accumulate.wgsl) never depends on the batching;
+        // from 64 on those multiples are block ends anyway.
         let per_dispatch = max_samples_per_dispatch(&self.params, self.loop_limit);
-        let mut done = 0;
-        while done < count {
-            let samples = per_dispatch.min(count - done);
-            self.dispatch_samples(self.samples + done, samples)?;
-            done += samples;
+        let step = 1u32 << (31 - per_dispatch.leading_zeros());
+        let end = self.samples + count;
+        let mut first = self.samples;
+        while first < end {
+            let next = (first / step + 1).saturating_mul(step).min(end);
+            self.dispatch_samples(first, next - first)?;
+            first = next;
         }
-        self.samples += count;
+        self.samples = end;
         let [nonfinite, cut_short] = self.take_counters()?;
         self.nonfinite += nonfinite as u64;
         if cut_short > 0 {

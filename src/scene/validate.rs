@@ -143,8 +143,9 @@ fn radiance_in_range(span: Range<usize>, field: &str, value: DVec3) -> Result<()
             span,
             field,
             format!(
-                "a radiance of {value} is too bright: at most {MAX_RADIANCE:e} per channel (the \
-                 numeric range glint supports)"
+                "a radiance of {:e} is too bright: at most {MAX_RADIANCE:e} per channel (the \
+                 numeric range glint supports)",
+                value.max_element()
             ),
         );
     }
