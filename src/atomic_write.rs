@@ -101,6 +101,23 @@ pub fn write_atomically<E: std::fmt::Display>(
     path: &Path,
     encode: impl FnOnce(&mut EncodeWriter<'_>) -> Result<(), E>,
 ) -> Result<()> {
+    write_atomically_with(path, |tmp, _| encode_into(tmp, path, encode))
+}
+
+/// The same for an encoder that writes a file by its path: it gets the temporary file's path
+/// and must write that file in place (open, truncate, write). Its errors are reported as it
+/// words them.
+pub fn write_atomically_via_path(
+    path: &Path,
+    encode: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
+    write_atomically_with(path, |_, tmp_path| encode(tmp_path))
+}
+
+fn write_atomically_with(
+    path: &Path,
+    encode: impl FnOnce(&File, &Path) -> Result<()>,
+) -> Result<()> {
     let target = resolve_output_target(path).map_err(anyhow::Error::msg)?;
     let folder = target.parent().unwrap_or(Path::new("/"));
     let existing_permissions = std::fs::metadata(&target)
@@ -115,7 +132,7 @@ pub fn write_atomically<E: std::fmt::Display>(
     let tmp = builder
         .tempfile_in(folder)
         .with_context(|| format!("cannot create a temporary file in {}", folder.display()))?;
-    encode_into(tmp.as_file(), path, encode)?;
+    encode(tmp.as_file(), tmp.path())?;
     if let Some(permissions) = existing_permissions {
         tmp.as_file()
             .set_permissions(permissions)
@@ -127,4 +144,26 @@ pub fn write_atomically<E: std::fmt::Display>(
     tmp.persist(&target)
         .with_context(|| format!("cannot write {}", path.display()))?;
     Ok(())
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::PermissionsExt;
+
+    #[test]
+    fn a_path_encoder_keeps_the_mode_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.bin");
+        std::fs::write(&path, b"old").unwrap();
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_atomically_via_path(&path, |tmp| Ok(std::fs::write(tmp, b"new")?)).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o600);
+        let failed = write_atomically_via_path(&path, |_| Err(anyhow!("encoder failed")));
+        assert!(failed.is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), b"new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
 }
