@@ -156,7 +156,9 @@ impl Partial {
             AnyChannels::sort(channels),
         );
         let image = exr::prelude::Image::from_layer(layer);
-        write_atomically(path, |tmp| {
+        // Through a temporary file next to `path`, then a rename (src/atomic_write.rs): a
+        // reader never sees half a file, and nothing is left on an error.
+        crate::atomic_write::write_atomically_via_path(path, |tmp| {
             image
                 .write()
                 .to_file(tmp)
@@ -291,27 +293,6 @@ fn text_attribute(attributes: &HashMap<Text, AttributeValue>, key: &str) -> Opti
         AttributeValue::Text(t) => Some(String::from_utf8_lossy(t.as_slice()).into_owned()),
         _ => None,
     }
-}
-
-/// Runs `encode` on a temporary file next to `path`, then renames it over `path`, so a reader
-/// never sees half a file. The temporary file is removed on any error.
-pub fn write_atomically(path: &Path, encode: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".glint-").suffix(".tmp");
-    // tempfile's default is 0600; an image is an ordinary file (the umask still applies).
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let tmp = builder
-        .tempfile_in(dir)
-        .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-    encode(tmp.path())?;
-    tmp.persist(path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
 }
 
 /// Writes a render's image to `path`: a partial file (mean, M2 and header) for `.exr`, so it

@@ -3,6 +3,7 @@
 //! count or the time limit is reached.
 
 use crate::accumulation::Accumulation;
+use crate::cpu::accumulate::next_block_end;
 use crate::output::Image;
 use anyhow::Result;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -42,6 +43,9 @@ pub trait Renderer {
     fn last_kernel_time(&self) -> Option<Duration> {
         None
     }
+    /// Samples dropped since the last reset because they were NaN, infinite or too large
+    /// (`shaders/accumulate.wgsl`); each counted as black.
+    fn nonfinite_samples(&self) -> u64;
     /// Adapter name, or "cpu".
     fn device_name(&self) -> String;
     fn backend_name(&self) -> String;
@@ -192,7 +196,13 @@ pub fn render_progressive(
             stop_reason = StopReason::Interrupted;
             break;
         }
-        let count = sizer.spp_per_batch.min(spp - renderer.samples());
+        // Batches end only where the merge schedule's blocks do, so the image's bytes do not
+        // depend on the batch sizes, which follow the wall clock (src/cpu/accumulate.rs). The
+        // blocks are of global sample indices, so a partial render's batches end where a
+        // single render's would.
+        let first = renderer.first_sample();
+        let done = first + renderer.samples();
+        let count = next_block_end(done, sizer.spp_per_batch, first + spp) - done;
         let batch_start = Instant::now();
         renderer.add_samples(count)?;
         let took = batch_start.elapsed();
@@ -238,11 +248,13 @@ pub fn render_progressive(
     })
 }
 
-/// Adds samples until there are `spp`, in batches of `batch`, and returns the mean image: the
+/// Adds samples until there are `spp`, in batches of about `batch` (rounded up to the merge
+/// schedule's block ends, like [`render_progressive`]'s), and returns the mean image: the
 /// simple path for tests and tools that want no progress reporting.
 pub fn render_image(renderer: &mut dyn Renderer, spp: u32, batch: u32) -> Result<Image> {
     while renderer.samples() < spp {
-        renderer.add_samples(batch.max(1).min(spp - renderer.samples()))?;
+        let done = renderer.samples();
+        renderer.add_samples(next_block_end(done, batch, spp) - done)?;
     }
     renderer.read_mean()
 }

@@ -2,7 +2,7 @@
 
 use crate::error::InputError;
 use crate::merge::{merge, Part};
-use crate::output::{check_output_path, ImageFormat};
+use crate::output_check::OutputSet;
 use crate::partial::{format_ranges, write_image, Partial};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -31,17 +31,15 @@ pub struct MergeArgs {
 
 pub fn run(args: MergeArgs) -> Result<()> {
     let started = Instant::now();
-    check_output_path(&args.output).map_err(InputError)?;
-    if let Some(variance) = &args.variance {
-        check_output_path(variance).map_err(InputError)?;
-        if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
-            return Err(InputError(format!(
-                "{}: --variance needs an .exr file (linear floats)",
-                variance.display()
-            ))
-            .into());
-        }
+    // Every output writable, none the same file as another or as a part (src/output_check.rs).
+    let mut outputs = OutputSet::new();
+    for part in &args.parts {
+        outputs = outputs.input("a part", part);
     }
+    outputs
+        .image("-o", &args.output)
+        .exr_opt("--variance", args.variance.as_deref())
+        .check()?;
     let mut parts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
         let partial = Partial::read(path).map_err(InputError)?;
@@ -91,7 +89,7 @@ pub fn run(args: MergeArgs) -> Result<()> {
             "merge_seconds": merge_seconds,
             "wall_seconds": started.elapsed().as_secs_f64(),
         });
-        println!("{summary}");
+        crate::outln!("{summary}");
     } else {
         let mut line = format!(
             "merged {} parts: samples {} of 0..{} ({} spp)",
@@ -103,7 +101,7 @@ pub fn run(args: MergeArgs) -> Result<()> {
         if !merged.missing.is_empty() {
             line += &format!("; missing {}", format_ranges(&merged.missing));
         }
-        eprintln!("{line}");
+        crate::errln!("{line}");
     }
     Ok(())
 }

@@ -55,10 +55,10 @@ pub fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             if let Some(interrupted) = e.downcast_ref::<crate::interrupt::Interrupted>() {
-                eprintln!("glint: {interrupted}");
+                crate::errln!("glint: {interrupted}");
                 return ExitCode::from(crate::interrupt::exit_code(interrupted.signal));
             }
-            eprintln!("glint: error: {e:#}");
+            crate::errln!("glint: error: {e:#}");
             if e.downcast_ref::<InputError>().is_some() {
                 ExitCode::from(2)
             } else {

@@ -6,9 +6,12 @@ use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::interrupt::{self, Interrupted};
-use crate::output::{check_output_path, ImageFormat};
+use crate::output::ImageFormat;
+use crate::output_check::OutputSet;
 use crate::partial::{format_range, settings_hash, PartialInfo};
-use crate::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
+use crate::render::{
+    relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
+};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::Result;
 use clap::Args;
@@ -53,15 +56,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub gpu: bool,
     /// Stop at the first batch boundary after this many seconds and write what is done.
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
     /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr.
     #[arg(long, value_name = "FILE.exr")]
     pub variance: Option<PathBuf>,
     /// Stop at the first batch boundary where the image's relative standard error,
     /// √(mean of the variance image) / (mean of the image), is at most E (checked from 8 spp on).
-    /// --spp is then the upper bound, and --time-limit still holds.
-    #[arg(long, value_name = "E", value_parser = parse_target_error)]
+    /// --spp is then the upper bound, and --time-limit still holds. On a black image (mean 0)
+    /// the relative error is undefined, so it never stops the render (a note says so).
+    #[arg(long, value_name = "E", value_parser = parse_target_error, allow_negative_numbers = true)]
     pub target_error: Option<f64>,
     /// Print a JSON summary on stdout at the end. Its "seconds" is the time spent rendering
     /// batches only: start-up, scene upload, shader compilation and file writes are not in it
@@ -76,12 +80,17 @@ pub struct RenderArgs {
     pub checkpoint_interval: Duration,
 }
 
+/// Longest `--time-limit`: about 31 years, far inside what a `Duration` holds (1.8e19 s).
+const MAX_TIME_LIMIT_SECONDS: f64 = 1e9;
+
 fn parse_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .parse()
         .map_err(|_| format!("{s:?} is not a number of seconds"))?;
-    if !v.is_finite() || v < 0.0 {
-        return Err(format!("must be a finite number ≥ 0, got {s}"));
+    if !(0.0..=MAX_TIME_LIMIT_SECONDS).contains(&v) {
+        return Err(format!(
+            "must be a number of seconds in [0, {MAX_TIME_LIMIT_SECONDS:e}], got {s}"
+        ));
     }
     Ok(v)
 }
@@ -111,7 +120,7 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
         Ok(ctx) => Ok(Some(ctx)),
         Err(e) if args.gpu => Err(anyhow::Error::new(e).context("--gpu was given")),
         Err(e) => {
-            eprintln!("glint: {e}; rendering on the CPU reference instead");
+            crate::errln!("glint: {e}; rendering on the CPU reference instead");
             Ok(None)
         }
     }
@@ -139,7 +148,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let output = args.output.clone().unwrap_or_else(|| {
         sample_range::default_output(&args.scene, &plan, &args.range, settings.spp)
     });
-    check_output_path(&output).map_err(InputError)?;
+    OutputSet::new()
+        .input("the scene file", &args.scene)
+        .image("-o", &output)
+        .exr_opt("--variance", args.variance.as_deref())
+        .check()?;
     if plan.is_partial(settings.spp) && ImageFormat::from_path(&output) != Ok(ImageFormat::Exr) {
         return Err(InputError(format!(
             "{}: a partial render (samples {} of {}) needs an .exr output to hold what a merge needs",
@@ -148,16 +161,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
             settings.spp
         ))
         .into());
-    }
-    if let Some(variance) = &args.variance {
-        check_output_path(variance).map_err(InputError)?;
-        if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
-            return Err(InputError(format!(
-                "{}: --variance needs an .exr file (linear floats)",
-                variance.display()
-            ))
-            .into());
-        }
     }
 
     let gpu = open_gpu(&args)?;
@@ -223,9 +226,21 @@ pub fn run(args: RenderArgs) -> Result<()> {
         },
     )?;
     progress.finish_and_clear();
+    if args.target_error.is_some() && stats.relative_error.is_none() {
+        crate::errln!(
+            "glint: note: --target-error never applied: the image is black (or below {MIN_SPP_FOR_TARGET_ERROR} spp), so its relative error is undefined"
+        );
+    }
     let (mean, variance) = writer.finish(renderer.as_mut())?;
     let first = renderer.first_sample();
 
+    let nonfinite = renderer.nonfinite_samples();
+    if nonfinite > 0 {
+        crate::errln!(
+            "glint: warning: {nonfinite} samples were NaN, infinite or above 1e14 and were \
+             dropped (counted as black)"
+        );
+    }
     if args.json {
         let seconds = stats.render_time.as_secs_f64();
         // This run's paths only, not a resumed file's.
@@ -244,12 +259,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "paths_per_second": paths as f64 / seconds.max(1e-9),
             "wall_seconds": started.elapsed().as_secs_f64(),
             "stopped_by": stats.stop_reason.as_str(),
-            "relative_error": relative_error(&mean, &variance),
+            // Below 2 spp there is no variance estimate: the error is unknown (null), not 0.
+            "relative_error": (stats.spp >= 2).then(|| relative_error(&mean, &variance)).flatten(),
+            "nonfinite_samples": renderer.nonfinite_samples(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
             "samples": [first, first + stats.spp],
         });
-        println!("{summary}");
+        crate::outln!("{summary}");
     }
     if let Some(signal) = interrupt::requested() {
         return Err(Interrupted {

@@ -40,7 +40,7 @@ impl RenderWriter {
         let partial = self.partial(renderer)?;
         if let Err(e) = write_image(&self.output, &partial) {
             if !self.checkpoint_warned {
-                eprintln!(
+                crate::errln!(
                     "glint: warning: cannot write the checkpoint {}: {e:#}; rendering on and trying again at the next checkpoint",
                     self.output.display()
                 );

@@ -2,12 +2,14 @@
 //! names, the same random stream and the same f32 operations. It is the oracle for the GPU
 //! and the fallback where there is no Vulkan device.
 
+pub mod accumulate;
 pub mod camera;
 pub mod intersect;
 pub mod lights;
 pub mod material;
 pub mod renderer;
 pub mod rng;
+pub mod surface;
 pub mod trace;
 
 use glam::Vec3;

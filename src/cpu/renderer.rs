@@ -120,6 +120,10 @@ impl Renderer for CpuRenderer {
         Some(self.segments)
     }
 
+    fn nonfinite_samples(&self) -> u64 {
+        self.stats.iter().map(|s| s.nonfinite as u64).sum()
+    }
+
     fn device_name(&self) -> String {
         "cpu".into()
     }
