@@ -4,9 +4,10 @@ const NO_HIT: f32 = 3.402823e38;
 
 struct Hit {
     t: f32,
-    // The hit point; on spheres projected back onto the surface, so errors cannot build up
-    // over many bounces.
+    // The hit point, put back on the surface (surface.wgsl), so errors cannot build up over
+    // many bounces, and a bound on its rounding error per coordinate.
     position: vec3<f32>,
+    error: vec3<f32>,
     // Geometric normal, unit length, facing against the incoming ray. It alone decides which
     // side of the surface a ray is on (offsets, entering or leaving glass).
     normal: vec3<f32>,
@@ -131,23 +132,34 @@ fn intersect_scene(ray: Ray) -> Hit {
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
         outward = normalize(ray.origin + closest.t * ray.dir - s.center);
-        hit.position = s.center + s.radius * outward;
+        let surface = sphere_point(s.center, s.radius, outward);
+        hit.position = surface.position;
+        hit.error = surface.error;
         hit.material = s.material;
     } else if HAS_TRIANGLES && closest.primitive == PRIMITIVE_TRIANGLE {
         let tri = triangles[closest.index];
         let b = triangle_barycentrics(tri, triangle_ray(ray));
         outward = triangle_normal(tri);
-        // On the triangle's plane, from its own vertices, as spheres are projected.
-        hit.position = b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
+        // On the triangle's plane: v0 + b1 e1 + b2 e2, from the edges the normal is made of.
+        let surface = triangle_surface_point(tri, b);
+        hit.position = surface.position;
+        hit.error = surface.error;
         hit.material = tri.material;
         let n = triangle_normals[closest.index];
         if n.smooth_shading != 0u {
             shading = normalize(b.x * n.n0 + b.y * n.n1 + b.z * n.n2);
         }
     } else {
-        outward = quads[closest.index].normal;
-        hit.position = ray.origin + closest.t * ray.dir;
-        hit.material = quads[closest.index].material;
+        let q = quads[closest.index];
+        outward = q.normal;
+        // On the plane through corner, edge_u and edge_v: the hit test's a and b, clamped.
+        let w = ray.origin + closest.t * ray.dir - q.corner;
+        let a = clamp(dot(q.u_dual, w), 0.0, 1.0);
+        let b = clamp(dot(q.v_dual, w), 0.0, 1.0);
+        let surface = parametric_point(q.corner, q.edge_u, q.edge_v, a, b);
+        hit.position = surface.position;
+        hit.error = surface.error;
+        hit.material = q.material;
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;
     hit.normal = select(-outward, outward, hit.front_face);
@@ -163,13 +175,4 @@ fn intersect_scene(ray: Ray) -> Hit {
 // directions carry nothing. Never true where the shading normal is the geometric one.
 fn crosses_shading_side(dir: vec3<f32>, hit: Hit) -> bool {
     return HAS_TRIANGLES && dot(dir, hit.normal) * dot(dir, hit.shading_normal) < 0.0;
-}
-
-// Moves a surface point off the surface along n, by a few ulps of its own magnitude, so the
-// next ray cannot hit the surface it leaves, at any scene scale (Wächter and Binder,
-// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019).
-fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let of_i = vec3<i32>(256.0 * n);
-    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
-    return select(p_i, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
 }

@@ -86,6 +86,17 @@ fn triangle_barycentrics(tri: Triangle, r: TriangleRay) -> vec3<f32> {
     return vec3<f32>(e.u, e.v, e.w) / (e.u + e.v + e.w);
 }
 
+// The point with barycentric weights b (of v0, v1, v2), on the triangle's plane, with its
+// rounding error (surface.wgsl): v0 + b.y e1 + b.z e2, with the same edges as triangle_normal.
+// The watertight test shears the axes into one another, so its rounding along any axis
+// depends on every coordinate: the bound is the largest of the three, in every axis (else a
+// wall in the plane x = 0 would get no offset along x at all, and its rays would hit it again).
+fn triangle_surface_point(tri: Triangle, b: vec3<f32>) -> SurfacePoint {
+    let point = parametric_point(tri.v0, tri.v1 - tri.v0, tri.v2 - tri.v0, b.y, b.z);
+    let e = point.error;
+    return SurfacePoint(point.position, vec3<f32>(max(e.x, max(e.y, e.z))));
+}
+
 fn triangle_normal(tri: Triangle) -> vec3<f32> {
     return normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
 }

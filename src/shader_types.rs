@@ -33,8 +33,15 @@ pub struct Params {
     pub emitter_count: u32,
     /// Russian roulette after the scattering at this bounce and later ones (`ROULETTE_OFF`: off).
     pub roulette_start: u32,
-    pub triangle_count: u32,
+    /// Samples already in the accumulators (the pairwise merge's n_old): `sample_start` less
+    /// the first sample of a partial render (`--samples A..B`), which need not start at 0.
+    pub accumulated_samples: u32,
     pub pad1: u32,
+    /// Meshes (issue 11), in a block of their own so the fields above keep their offsets.
+    pub triangle_count: u32,
+    pub pad2: u32,
+    pub pad3: u32,
+    pub pad4: u32,
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.

@@ -101,8 +101,12 @@ fn rust_structs_match_wgsl_layout() {
             material_count,
             emitter_count,
             roulette_start,
+            accumulated_samples,
+            pad1,
             triangle_count,
-            pad1
+            pad2,
+            pad3,
+            pad4
         ]
     );
     assert_same_layout!(

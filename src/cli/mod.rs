@@ -2,7 +2,10 @@
 
 mod bench;
 mod compare;
+mod merge;
 mod render;
+mod render_writer;
+mod sample_range;
 mod stress_mesh;
 mod view;
 
@@ -25,6 +28,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene file to a PNG or EXR image.
     Render(render::RenderArgs),
+    /// Merge partial renders (--samples, --shard) into one image, exactly.
+    Merge(merge::MergeArgs),
     /// Compare two EXR renders: error metrics and, with variance images, per-pixel Z-tests.
     Compare(compare::CompareArgs),
     /// Measure paths/s on the GPU and the CPU reference (Cornell box, 256² and 512²).
@@ -44,6 +49,7 @@ pub fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Merge(args) => merge::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Bench(args) => bench::run(args),
         Command::View(args) => view::run(args),
@@ -52,7 +58,11 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("glint: error: {e:#}");
+            if let Some(interrupted) = e.downcast_ref::<crate::interrupt::Interrupted>() {
+                crate::errln!("glint: {interrupted}");
+                return ExitCode::from(crate::interrupt::exit_code(interrupted.signal));
+            }
+            crate::errln!("glint: error: {e:#}");
             if e.downcast_ref::<InputError>().is_some() {
                 ExitCode::from(2)
             } else {

@@ -1,8 +1,10 @@
 //! `glint stress-mesh`: writes the generated stress mesh (a displaced sphere) as PLY.
 
+use crate::atomic_write::write_atomically;
 use crate::error::InputError;
+use crate::output_check::OutputSet;
 use crate::scene::stress::StressMesh;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -31,10 +33,11 @@ pub fn run(args: StressMeshArgs) -> Result<()> {
         ))
         .into());
     }
+    OutputSet::new().file("the output", &args.output).check()?;
     let mesh = StressMesh::with_triangles(args.triangles);
-    mesh.write_ply(&args.output)
-        .with_context(|| format!("writing {}", args.output.display()))?;
-    eprintln!(
+    // Atomically: an error or an interruption leaves no half-written file.
+    write_atomically(&args.output, |out| mesh.encode_ply(out))?;
+    crate::errln!(
         "glint: wrote {} ({} triangles)",
         args.output.display(),
         mesh.indices.len()

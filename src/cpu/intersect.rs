@@ -1,13 +1,16 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
 use super::bvh::{bvh_closest_primitive, bvh_first_hit_is};
-use super::triangle::{hit_triangle, triangle_barycentrics, triangle_normal, triangle_ray};
+use super::surface::{parametric_point, sphere_point};
+use super::triangle::{
+    hit_triangle, triangle_barycentrics, triangle_normal, triangle_ray, triangle_surface_point,
+};
 use super::Ray;
 use crate::shader_types::{
     BvhNode, Quad, Sphere, Triangle, TriangleNormals, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
     PRIMITIVE_TRIANGLE,
 };
-use glam::{BVec3, IVec3, Vec3};
+use glam::Vec3;
 
 /// The scene's surfaces as the kernel's intersection code reads them. With `bvh_nodes` empty,
 /// every ray tests every primitive (the kernel's `USE_BVH = false`).
@@ -37,9 +40,10 @@ pub const NO_HIT: f32 = 3.402823e38;
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub t: f32,
-    /// The hit point; on spheres projected back onto the surface, so errors cannot build up
-    /// over many bounces.
+    /// The hit point, put back on the surface (`surface.rs`), so errors cannot build up over
+    /// many bounces, and a bound on its rounding error per coordinate.
     pub position: Vec3,
+    pub error: Vec3,
     /// Geometric normal, unit length, facing against the incoming ray. It alone decides which
     /// side of the surface a ray is on (offsets, entering or leaving glass).
     pub normal: Vec3,
@@ -174,6 +178,7 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
         return Hit {
             t: NO_HIT,
             position: Vec3::ZERO,
+            error: Vec3::ZERO,
             normal: Vec3::ZERO,
             shading_normal: Vec3::ZERO,
             material: 0,
@@ -184,14 +189,14 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
     }
     // Zero: shade with the geometric normal.
     let mut shading = Vec3::ZERO;
-    let (outward, position, material) = if closest.primitive == PRIMITIVE_SPHERE {
+    let (outward, surface, material) = if closest.primitive == PRIMITIVE_SPHERE {
         let s = &geometry.spheres[closest.index as usize];
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
         let outward = (ray.origin + closest.t * ray.dir - Vec3::from(s.center)).normalize();
         (
             outward,
-            Vec3::from(s.center) + s.radius * outward,
+            sphere_point(Vec3::from(s.center), s.radius, outward),
             s.material,
         )
     } else if closest.primitive == PRIMITIVE_TRIANGLE {
@@ -202,17 +207,27 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
             shading = (b.x * Vec3::from(n.n0) + b.y * Vec3::from(n.n1) + b.z * Vec3::from(n.n2))
                 .normalize();
         }
-        // On the triangle's plane, from its own vertices, as spheres are projected.
+        // On the triangle's plane: v0 + b1 e1 + b2 e2, from the edges the normal is made of.
         (
             triangle_normal(tri),
-            b.x * Vec3::from(tri.v0) + b.y * Vec3::from(tri.v1) + b.z * Vec3::from(tri.v2),
+            triangle_surface_point(tri, b),
             tri.material,
         )
     } else {
         let q = &geometry.quads[closest.index as usize];
+        // On the plane through corner, edge_u and edge_v: the hit test's a and b, clamped.
+        let w = ray.origin + closest.t * ray.dir - Vec3::from(q.corner);
+        let a = Vec3::from(q.u_dual).dot(w).clamp(0.0, 1.0);
+        let b = Vec3::from(q.v_dual).dot(w).clamp(0.0, 1.0);
         (
             Vec3::from(q.normal),
-            ray.origin + closest.t * ray.dir,
+            parametric_point(
+                Vec3::from(q.corner),
+                Vec3::from(q.edge_u),
+                Vec3::from(q.edge_v),
+                a,
+                b,
+            ),
             q.material,
         )
     };
@@ -229,7 +244,8 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
     };
     Hit {
         t: closest.t,
-        position,
+        position: surface.position,
+        error: surface.error,
         normal,
         shading_normal,
         material,
@@ -244,25 +260,4 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
 /// directions carry nothing. Never true where the shading normal is the geometric one.
 pub fn crosses_shading_side(dir: Vec3, hit: &Hit) -> bool {
     dir.dot(hit.normal) * dir.dot(hit.shading_normal) < 0.0
-}
-
-/// Moves a surface point off the surface along `n`, by a few ulps of its own magnitude, so the
-/// next ray cannot hit the surface it leaves, at any scene scale (Wächter and Binder,
-/// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019).
-pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
-    let of_i = (256.0 * n).as_ivec3();
-    let bits = IVec3::new(
-        p.x.to_bits() as i32,
-        p.y.to_bits() as i32,
-        p.z.to_bits() as i32,
-    );
-    let step = IVec3::select(p.cmplt(Vec3::ZERO), -of_i, of_i);
-    let moved = bits.wrapping_add(step);
-    let p_i = Vec3::new(
-        f32::from_bits(moved.x as u32),
-        f32::from_bits(moved.y as u32),
-        f32::from_bits(moved.z as u32),
-    );
-    let near_origin: BVec3 = p.abs().cmplt(Vec3::splat(1.0 / 32.0));
-    Vec3::select(near_origin, p + (1.0 / 65536.0) * n, p_i)
 }

@@ -7,6 +7,7 @@
 //! the triangles, never outside both.
 
 use super::intersect::NO_HIT;
+use super::surface::{parametric_point, SurfacePoint};
 use super::Ray;
 use crate::shader_types::Triangle;
 use glam::Vec3;
@@ -99,6 +100,26 @@ pub fn hit_triangle(tri: &Triangle, r: &TriangleRay) -> f32 {
 pub fn triangle_barycentrics(tri: &Triangle, r: &TriangleRay) -> Vec3 {
     let e = triangle_edges(tri, r);
     Vec3::new(e.u, e.v, e.w) / (e.u + e.v + e.w)
+}
+
+/// The point with barycentric weights `b` (of v0, v1, v2), on the triangle's plane, with its
+/// rounding error (`surface.rs`): v0 + b.y e1 + b.z e2, with the same edges as `triangle_normal`.
+/// The watertight test shears the axes into one another, so its rounding along any axis
+/// depends on every coordinate: the bound is the largest of the three, in every axis (else a
+/// wall in the plane x = 0 would get no offset along x at all, and its rays would hit it again).
+pub fn triangle_surface_point(tri: &Triangle, b: Vec3) -> SurfacePoint {
+    let v0 = Vec3::from(tri.v0);
+    let point = parametric_point(
+        v0,
+        Vec3::from(tri.v1) - v0,
+        Vec3::from(tri.v2) - v0,
+        b.y,
+        b.z,
+    );
+    SurfacePoint {
+        position: point.position,
+        error: Vec3::splat(point.error.max_element()),
+    }
 }
 
 pub fn triangle_normal(tri: &Triangle) -> Vec3 {

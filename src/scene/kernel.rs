@@ -3,6 +3,7 @@
 
 use super::bvh;
 use super::{CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
+use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, Params, TriangleNormals, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
     MATERIAL_METAL, MATERIAL_SPECULAR, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
@@ -42,31 +43,18 @@ impl KernelScene {
             + bytes(&self.bvh_nodes)
             + bytes(&self.bvh_primitives)
     }
-
-    /// The largest single array, with its name: each must fit one storage binding.
-    pub fn largest_array(&self) -> (&'static str, u64) {
-        fn bytes<T>(items: &[T]) -> u64 {
-            std::mem::size_of_val(items) as u64
-        }
-        [
-            ("spheres", bytes(&self.spheres)),
-            ("quads", bytes(&self.quads)),
-            ("materials", bytes(&self.materials)),
-            ("emitters", bytes(&self.emitters)),
-            ("triangles", bytes(&self.triangles)),
-            ("triangle normals", bytes(&self.triangle_normals)),
-            ("BVH nodes", bytes(&self.bvh_nodes)),
-            ("BVH primitive references", bytes(&self.bvh_primitives)),
-        ]
-        .into_iter()
-        .max_by_key(|&(_, b)| b)
-        .unwrap_or(("spheres", 0))
-    }
 }
 
 impl Scene {
-    /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission × strength).
+    /// [`Scene::try_kernel_scene`] for scenes known to fit the kernel (tests, the built-in
+    /// benchmark scene, the viewer); panics where that one returns an error.
     pub fn kernel_scene(&self) -> KernelScene {
+        self.try_kernel_scene().unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission ×
+    /// strength, the BVH). Fails (bad input) when the BVH is deeper than the traversal stack.
+    pub fn try_kernel_scene(&self) -> Result<KernelScene, InputError> {
         let c = &self.camera;
         let r = &self.render;
         let CameraBasis {
@@ -108,8 +96,12 @@ impl Scene {
             } else {
                 ROULETTE_OFF
             },
-            triangle_count: self.triangles.len() as u32,
+            accumulated_samples: 0,
             pad1: 0,
+            triangle_count: self.triangles.len() as u32,
+            pad2: 0,
+            pad3: 0,
+            pad4: 0,
         };
         let spheres = self
             .spheres
@@ -214,16 +206,15 @@ impl Scene {
             scene.quads.len(),
             scene.triangles.len(),
         ) {
-            // Validation bounds the primitive count far below what a reference holds, and
-            // trees from PLOC are far shallower than the stack, so this cannot fail for a
-            // scene that loaded.
+            // Validation bounds the primitive count far below what a reference holds; a tree
+            // deeper than the traversal stack (rare with PLOC) is refused.
             let tree = bvh::build(&scene.spheres, &scene.quads, &scene.triangles)
-                .unwrap_or_else(|e| panic!("BVH build: {e}"));
+                .map_err(|e| InputError(format!("the scene cannot be rendered: {e}")))?;
             scene.bvh_nodes = tree.nodes;
             scene.bvh_primitives = tree.primitives;
             scene.bvh_build_seconds = tree.build_seconds;
         }
-        scene
+        Ok(scene)
     }
 
     /// Every emitting primitive with its selection probability, proportional to its power

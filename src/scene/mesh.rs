@@ -4,8 +4,9 @@
 //! that are not finite, indices out of range, meshes left with no triangles.
 
 use super::{Material, MaterialKind, Triangle};
+use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec3};
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
@@ -318,10 +319,15 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
     ))
 }
 
+/// The bytes of a mesh file, if it is a regular file within [`MESH_FILE_LIMIT`].
+fn read_mesh_bytes(path: &Path) -> Result<Vec<u8>, String> {
+    read_regular_file(path, MESH_FILE_LIMIT, "mesh file")
+}
+
 fn read_obj(path: &Path) -> Result<MeshFile, String> {
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read the mesh file: {e}"))?;
+    let bytes = read_mesh_bytes(path)?;
     let mut reader = LineCounter {
-        inner: BufReader::new(file),
+        inner: &bytes[..],
         lines: 0,
     };
     let options = tobj::LoadOptions {
@@ -331,9 +337,13 @@ fn read_obj(path: &Path) -> Result<MeshFile, String> {
         ignore_lines: true,
     };
     let dir = path.parent().unwrap_or(Path::new(".")).to_owned();
-    let (models, materials) =
-        tobj::load_obj_buf(&mut reader, &options, |mtl| tobj::load_mtl(dir.join(mtl)))
-            .map_err(|e| format!("line {}: malformed OBJ: {e}", reader.lines.max(1)))?;
+    let (models, materials) = tobj::load_obj_buf(&mut reader, &options, |mtl| {
+        // The same checks as the mesh file itself (a FIFO or a huge file is not read).
+        let mtl = read_regular_file(&dir.join(mtl), MESH_FILE_LIMIT, "material file")
+            .map_err(|_| tobj::LoadError::OpenFileFailed)?;
+        tobj::load_mtl_buf(&mut &mtl[..])
+    })
+    .map_err(|e| format!("line {}: malformed OBJ: {e}", reader.lines.max(1)))?;
     // A missing or broken .mtl leaves the faces without materials; a face that needs one says so.
     let materials = materials.unwrap_or_default();
     let mut has_textures = false;
@@ -370,8 +380,8 @@ fn read_obj(path: &Path) -> Result<MeshFile, String> {
 fn read_ply(path: &Path) -> Result<MeshFile, String> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Property};
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot read the mesh file: {e}"))?;
-    let mut reader = BufReader::new(file);
+    let bytes = read_mesh_bytes(path)?;
+    let mut reader = &bytes[..];
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut reader)
         // The reader's messages span several lines; errors here are one line.
@@ -506,7 +516,7 @@ fn gltf_material(m: &gltf::Material, index: usize) -> Result<(Material, bool), S
 }
 
 fn read_gltf(path: &Path) -> Result<MeshFile, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read the mesh file: {e}"))?;
+    let bytes = read_mesh_bytes(path)?;
     let gltf = gltf::Gltf::from_slice(&bytes)
         .map_err(|e| format!("malformed glTF: {}", one_line(&e.to_string())))?;
     let buffers = gltf::import_buffers(&gltf.document, path.parent(), gltf.blob.clone())

@@ -82,6 +82,12 @@ impl StressMesh {
     /// Writes binary little-endian PLY (positions, normals, triangles).
     pub fn write_ply(&self, path: &Path) -> std::io::Result<()> {
         let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        self.encode_ply(&mut out)?;
+        out.flush()
+    }
+
+    /// The binary PLY file, written to `out`.
+    pub fn encode_ply(&self, out: &mut impl Write) -> std::io::Result<()> {
         write!(
             out,
             "ply\nformat binary_little_endian 1.0\ncomment glint stress-mesh: a displaced sphere\n\
@@ -102,6 +108,6 @@ impl StressMesh {
                 out.write_all(&(*i as i32).to_le_bytes())?;
             }
         }
-        out.flush()
+        Ok(())
     }
 }
