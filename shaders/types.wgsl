@@ -29,8 +29,10 @@ struct Params {
     emitter_count: u32,
     // Russian roulette after the scattering at this bounce and later ones (0xffffffff: off).
     roulette_start: u32,
-    pad0: u32,
-    pad1: u32,
+    // Firefly clamp: the most a contribution of scattered light may add (0: off; trace.wgsl).
+    radiance_clamp: f32,
+    // 1: accumulate the denoiser's albedo, normal and depth (aov.wgsl); needs AOVS compiled in.
+    aovs: u32,
 }
 
 struct Sphere {

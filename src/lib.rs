@@ -4,10 +4,12 @@
 //! Data flows one way: scene file → [`scene::Scene`] (validated) → [`scene::KernelScene`]
 //! (the kernel's structs) → a [`render::Renderer`] (GPU or CPU) → [`output::Image`].
 
+pub mod aov;
 pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod cpu;
+pub mod denoise;
 pub mod error;
 pub mod gpu;
 pub mod output;
@@ -15,4 +17,5 @@ pub mod render;
 pub mod scene;
 pub mod shader;
 pub mod shader_types;
+pub mod tonemap;
 pub mod viewer;

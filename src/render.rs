@@ -2,8 +2,9 @@
 //! each submission stays short (a real GPU's watchdog kills long ones), until the sample
 //! count or the time limit is reached.
 
+use crate::aov::Aovs;
 use crate::output::Image;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use std::time::{Duration, Instant};
 
 /// A device that accumulates per-pixel radiance statistics.
@@ -18,6 +19,11 @@ pub trait Renderer {
     /// The variance of each pixel's mean estimate (σ²/n per channel, from the unbiased sample
     /// variance); zero before two samples.
     fn read_variance(&mut self) -> Result<Image>;
+    /// The mean albedo, normal and depth per pixel, for the denoiser; an error unless the
+    /// scene's `Params::aovs` asked for them.
+    fn read_aovs(&mut self) -> Result<Aovs> {
+        Err(anyhow!("this renderer does not accumulate AOVs"))
+    }
     /// Forgets all samples.
     fn reset(&mut self) -> Result<()>;
     /// Ray segments traced since the last reset (camera, bounce and shadow rays), where the

@@ -8,13 +8,14 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 7] = [
+pub const SHADER_PARTS: [(&str, &str); 8] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
+    ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
     ("trace.wgsl", include_str!("../shaders/trace.wgsl")),
 ];
 
@@ -126,6 +127,8 @@ pub struct KernelFeatures {
     pub quad_emitters: bool,
     pub metal: bool,
     pub dielectric: bool,
+    /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/aov.wgsl).
+    pub aovs: bool,
 }
 
 impl KernelFeatures {
@@ -136,6 +139,7 @@ impl KernelFeatures {
         quad_emitters: true,
         metal: true,
         dielectric: true,
+        aovs: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -148,6 +152,7 @@ impl KernelFeatures {
             quad_emitters: emits(PRIMITIVE_QUAD),
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
+            aovs: scene.params.aovs != 0,
         }
     }
 
@@ -159,6 +164,7 @@ impl KernelFeatures {
             && needs(self.quad_emitters, other.quad_emitters)
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
+            && needs(self.aovs, other.aovs)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -166,12 +172,13 @@ impl KernelFeatures {
         format!(
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_METAL: bool = {};\n\
-             const HAS_DIELECTRIC: bool = {};\n",
+             const HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
             self.metal,
-            self.dielectric
+            self.dielectric,
+            self.aovs
         )
     }
 }

@@ -33,8 +33,10 @@ pub struct Params {
     pub emitter_count: u32,
     /// Russian roulette after the scattering at this bounce and later ones (`ROULETTE_OFF`: off).
     pub roulette_start: u32,
-    pub pad0: u32,
-    pub pad1: u32,
+    /// Firefly clamp: the most a contribution of scattered light may add (0: off).
+    pub radiance_clamp: f32,
+    /// 1: accumulate the denoiser's albedo, normal and depth; needs `KernelFeatures::aovs`.
+    pub aovs: u32,
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.

@@ -99,8 +99,8 @@ fn rust_structs_match_wgsl_layout() {
             material_count,
             emitter_count,
             roulette_start,
-            pad0,
-            pad1
+            radiance_clamp,
+            aovs
         ]
     );
     assert_same_layout!(
@@ -243,13 +243,14 @@ fn every_feature_combination_validates() {
         materials: 5,
         emitters: 1,
     };
-    for bits in 0..32u32 {
+    for bits in 0..64u32 {
         let features = KernelFeatures {
             light_sampling: bits & 1 != 0,
             sphere_emitters: bits & 2 != 0,
             quad_emitters: bits & 4 != 0,
             metal: bits & 8 != 0,
             dielectric: bits & 16 != 0,
+            aovs: bits & 32 != 0,
         };
         for binding in [SceneBinding::Storage, SceneBinding::Uniform(counts)] {
             validate_source(render_kernel_source_for(KernelVariant {

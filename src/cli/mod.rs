@@ -2,6 +2,7 @@
 
 mod bench;
 mod compare;
+mod post;
 mod render;
 mod view;
 

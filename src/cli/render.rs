@@ -1,5 +1,6 @@
 //! `glint render`.
 
+use super::post::PostArgs;
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
@@ -66,6 +67,8 @@ pub struct RenderArgs {
     /// ("wall_seconds" is the whole command).
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub post: PostArgs,
 }
 
 fn parse_seconds(s: &str) -> Result<f64, String> {
@@ -143,8 +146,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
             .into());
         }
     }
+    let main_outputs: Vec<&Path> = [Some(&output), args.variance.as_ref()]
+        .into_iter()
+        .flatten()
+        .map(|p| p.as_path())
+        .collect();
+    args.post.check(&main_outputs)?;
 
-    let kernel_scene = scene.kernel_scene();
+    let mut kernel_scene = scene.kernel_scene();
+    args.post.configure(&mut kernel_scene.params);
     let gpu = open_gpu(&args)?;
     let mut renderer: Box<dyn Renderer + '_> = match &gpu {
         Some(ctx) => Box::new(GpuRenderer::new(ctx, &kernel_scene)?),
@@ -185,7 +195,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             if report.spp_done < report.spp_target
                 && last_checkpoint.elapsed() >= CHECKPOINT_INTERVAL
             {
-                r.read_mean()?.write(&output)?;
+                args.post.write_output(&r.read_mean()?, &output)?;
                 last_checkpoint = Instant::now();
             }
             Ok(())
@@ -194,8 +204,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     progress.finish_and_clear();
     let mean = renderer.read_mean()?;
     let variance = renderer.read_variance()?;
-    mean.write(&output)
-        .with_context(|| format!("writing {}", output.display()))?;
+    let denoise_seconds = args.post.finish(renderer.as_mut(), &mean, &output)?;
     if let Some(path) = &args.variance {
         variance
             .write(path)
@@ -221,6 +230,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "relative_error": relative_error(&mean, &variance),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
+            "denoise_seconds": denoise_seconds,
         });
         println!("{summary}");
     }

@@ -2,6 +2,7 @@
 //! names, the same random stream and the same f32 operations. It is the oracle for the GPU
 //! and the fallback where there is no Vulkan device.
 
+pub mod aov;
 pub mod camera;
 pub mod intersect;
 pub mod lights;

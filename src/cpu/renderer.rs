@@ -1,10 +1,11 @@
 //! The CPU renderer: the kernel's entry point run over all pixels, rows in parallel (rayon).
 
 use super::trace::{render_pixel, PixelStats, SceneRefs};
+use crate::aov::Aovs;
 use crate::output::Image;
 use crate::render::{variance_of_mean, Renderer};
 use crate::scene::KernelScene;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use rayon::prelude::*;
 
 pub struct CpuRenderer {
@@ -75,6 +76,26 @@ impl Renderer for CpuRenderer {
     fn read_variance(&mut self) -> Result<Image> {
         let n = self.samples;
         Ok(self.image(|s| variance_of_mean(s.m2.into(), n)))
+    }
+
+    fn read_aovs(&mut self) -> Result<Aovs> {
+        if self.scene.params.aovs == 0 {
+            return Err(anyhow!(
+                "this render does not accumulate AOVs (Params::aovs is 0)"
+            ));
+        }
+        let albedo_depth: Vec<[f32; 4]> = self
+            .stats
+            .iter()
+            .map(|s| s.aov.albedo.extend(s.aov.depth).into())
+            .collect();
+        let normal: Vec<[f32; 4]> = self
+            .stats
+            .iter()
+            .map(|s| s.aov.normal.extend(0.0).into())
+            .collect();
+        let p = &self.scene.params;
+        Ok(Aovs::from_vec4s(p.width, p.height, &albedo_depth, &normal))
     }
 
     fn reset(&mut self) -> Result<()> {

@@ -56,8 +56,8 @@ impl Scene {
             } else {
                 ROULETTE_OFF
             },
-            pad0: 0,
-            pad1: 0,
+            radiance_clamp: 0.0,
+            aovs: 0,
         };
         let spheres = self
             .spheres
