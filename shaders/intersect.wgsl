@@ -4,9 +4,10 @@ const NO_HIT: f32 = 3.402823e38;
 
 struct Hit {
     t: f32,
-    // The hit point; on spheres projected back onto the surface, so errors cannot build up
-    // over many bounces.
+    // The hit point, put back on the surface (surface.wgsl), so errors cannot build up over
+    // many bounces, and a bound on its rounding error per coordinate.
     position: vec3<f32>,
+    error: vec3<f32>,
     // Geometric normal, unit length, facing against the incoming ray.
     normal: vec3<f32>,
     material: u32,
@@ -110,23 +111,23 @@ fn intersect_scene(ray: Ray) -> Hit {
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
         outward = normalize(ray.origin + closest.t * ray.dir - s.center);
-        hit.position = s.center + s.radius * outward;
+        let surface = sphere_point(s.center, s.radius, outward);
+        hit.position = surface.position;
+        hit.error = surface.error;
         hit.material = s.material;
     } else {
-        outward = quads[closest.index].normal;
-        hit.position = ray.origin + closest.t * ray.dir;
-        hit.material = quads[closest.index].material;
+        let q = quads[closest.index];
+        outward = q.normal;
+        // On the plane through corner, edge_u and edge_v: the hit test's a and b, clamped.
+        let w = ray.origin + closest.t * ray.dir - q.corner;
+        let a = clamp(dot(q.u_dual, w), 0.0, 1.0);
+        let b = clamp(dot(q.v_dual, w), 0.0, 1.0);
+        let surface = parametric_point(q.corner, q.edge_u, q.edge_v, a, b);
+        hit.position = surface.position;
+        hit.error = surface.error;
+        hit.material = q.material;
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;
     hit.normal = select(-outward, outward, hit.front_face);
     return hit;
-}
-
-// Moves a surface point off the surface along n, by a few ulps of its own magnitude, so the
-// next ray cannot hit the surface it leaves, at any scene scale (Wächter and Binder,
-// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019).
-fn offset_ray_origin(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let of_i = vec3<i32>(256.0 * n);
-    let p_i = bitcast<vec3<f32>>(bitcast<vec3<i32>>(p) + select(of_i, -of_i, p < vec3<f32>(0.0)));
-    return select(p_i, p + (1.0 / 65536.0) * n, abs(p) < vec3<f32>(1.0 / 32.0));
 }

@@ -149,12 +149,27 @@ fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, ind
     return s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p));
 }
 
-// Veach's power heuristic (beta = 2) for the sample drawn with pdf `a` against pdf `b`.
+// The largest finite f32.
+const F32_MAX: f32 = 3.40282347e38;
+
+// Veach's power heuristic (beta = 2) for the sample drawn with pdf `a` against pdf `b`:
+// a^2 / (a^2 + b^2), written with the ratio of the smaller pdf to the larger so that nothing
+// overflows (a light pdf can exceed 1e19, whose square is infinite in f32). Infinite pdfs
+// (a light too small or too grazing to sample) are taken as the largest finite ones.
 fn power_heuristic(a: f32, b: f32) -> f32 {
-    let a2 = a * a;
-    let b2 = b * b;
-    if a2 + b2 == 0.0 {
+    if !(a > 0.0) {
         return 0.0;
     }
-    return a2 / (a2 + b2);
+    if !(b > 0.0) {
+        return 1.0;
+    }
+    let a_max = min(a, F32_MAX);
+    let b_max = min(b, F32_MAX);
+    if a_max >= b_max {
+        let r = b_max / a_max;
+        return 1.0 / (1.0 + r * r);
+    }
+    let r = a_max / b_max;
+    let r2 = r * r;
+    return r2 / (1.0 + r2);
 }

@@ -71,7 +71,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     }
     let p = hit.position;
     let wo = -ray.dir;
-    let origin = offset_ray_origin(p, hit.normal);
+    let origin = offset_ray_origin(p, hit.error, hit.normal);
     if light_sampling && !is_delta(m) {
         // Next-event estimation: light arriving after one more scattering event.
         var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
@@ -109,7 +109,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     (*path).bsdf_pdf_of_ray = s.pdf;
     // Leave on the side the new direction goes to.
     let side = select(-hit.normal, hit.normal, dot(s.dir, hit.normal) >= 0.0);
-    (*path).ray = Ray(offset_ray_origin(p, side), s.dir);
+    (*path).ray = Ray(offset_ray_origin(p, hit.error, side), s.dir);
     (*path).ray_start = p;
     (*path).bounce = bounce + 1u;
     return false;
@@ -128,26 +128,23 @@ fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
 
 @compute @workgroup_size(8, 8, 1)
 fn render(@builtin(global_invocation_id) id: vec3<u32>) {
-    if id.x >= params.width || id.y >= params.height || params.sample_count == 0u {
+    let px = id.x + tile_origin.x;
+    let py = id.y + tile_origin.y;
+    if px >= params.width || py >= params.height || params.sample_count == 0u {
         return;
     }
-    let pixel = id.y * params.width + id.x;
-    // Welford over this batch's samples...
-    var mean = vec3<f32>(0.0);
-    var m2 = vec3<f32>(0.0);
+    let pixel = py * params.width + px;
+    var acc = accumulator_start(params.accumulated_samples, accum_mean[pixel].xyz, accum_m2[pixel].xyz);
     var aov_mean = aov_mean_start();
     // Path regeneration: one loop over segments, and a lane whose path ends starts its next
     // sample at once, instead of idling until the longest path among its SIMD neighbours
     // ends. Each sample's result is the same as trace_path's (the random numbers depend on
     // the sample, not on the schedule), and samples finish in order.
     var done = 0u;
-    var path = start_path(pixel, id.x, id.y, params.sample_start);
+    var path = start_path(pixel, px, py, params.sample_start);
     loop {
         if path_step(&path, pixel, params.sample_start + done) {
-            let x = path.radiance;
-            let delta = x - mean;
-            mean += delta / f32(done + 1u);
-            m2 += delta * (x - mean);
+            add_sample(&acc, path.radiance, params.sample_start + done);
             if aovs_on() {
                 aov_mean_add(&aov_mean, path.aov, done);
             }
@@ -155,19 +152,25 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
             if done == params.sample_count {
                 break;
             }
-            path = start_path(pixel, id.x, id.y, params.sample_start + done);
+            path = start_path(pixel, px, py, params.sample_start + done);
         }
     }
-    // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
-    let n_old = f32(params.sample_start);
-    let n_new = f32(params.sample_count);
-    let n = n_old + n_new;
-    let old_mean = accum_mean[pixel].xyz;
-    let delta = mean - old_mean;
-    accum_mean[pixel] = vec4<f32>(old_mean + delta * (n_new / n), 0.0);
-    accum_m2[pixel] = vec4<f32>(accum_m2[pixel].xyz + m2 + delta * delta * (n_old * n_new / n), 0.0);
+    // lavapipe (llvmpipe's gallivm) silently ends every loop of an invocation once all its
+    // loops together have made 65535 iterations; the path loop then stops short. Write
+    // nothing and let the host report it (src/gpu/loop_budget.rs keeps batches below it).
+    if done < params.sample_count {
+        atomicAdd(&accumulate_counters[1], 1u);
+        return;
+    }
+    // A batch the host ends inside a block keeps the statistics right.
+    merge_block(&acc);
+    accum_mean[pixel] = vec4<f32>(acc.mean, 0.0);
+    accum_m2[pixel] = vec4<f32>(acc.m2, 0.0);
     if aovs_on() {
-        aov_merge(pixel, aov_mean, n_old, n_new);
+        aov_merge(pixel, aov_mean, f32(params.accumulated_samples), f32(params.sample_count));
     }
     atomicAdd(&segments_traced, segments);
+    if acc.nonfinite > 0u {
+        atomicAdd(&accumulate_counters[0], acc.nonfinite);
+    }
 }

@@ -9,7 +9,7 @@ struct Params {
     height: u32,
     // Image-right and image-up, scaled to half the viewport at unit distance.
     right: vec3<f32>,
-    // Samples already in the accumulators: the global index of this batch's first sample.
+    // The global index of this batch's first sample (the random streams depend on it).
     sample_start: u32,
     up: vec3<f32>,
     sample_count: u32,
@@ -29,10 +29,13 @@ struct Params {
     emitter_count: u32,
     // Russian roulette after the scattering at this bounce and later ones (0xffffffff: off).
     roulette_start: u32,
-    // Firefly clamp: the most a contribution of scattered light may add (0: off; trace.wgsl).
-    radiance_clamp: f32,
+    // Samples already in the accumulators (the pairwise merge's n_old): sample_start less
+    // the first sample of a partial render (--samples A..B), which need not start at 0.
+    accumulated_samples: u32,
     // 1: accumulate the denoiser's albedo, normal and depth (aov.wgsl); needs AOVS compiled in.
     aovs: u32,
+    // Firefly clamp: the most a contribution of scattered light may add (0: off; trace.wgsl).
+    radiance_clamp: f32,
 }
 
 struct Sphere {

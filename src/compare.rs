@@ -22,12 +22,18 @@ pub struct Comparison {
     pub max_difference: f64,
     /// With variances: the Z-test results.
     pub z_test: Option<ZTest>,
+    /// Pixel channels of A that are NaN or infinite. Every figure above leaves out the pixel
+    /// channels where A or B (or, in the Z-test, a variance) is not finite, so one NaN cannot
+    /// turn them all into NaN; these counts say how many there were.
+    pub nonfinite_a: usize,
+    pub nonfinite_b: usize,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct ZTest {
     /// Fraction of pixel channels with |z| ≤ [`Z_CRITICAL`], z = (A − B) / √(VA + VB).
     pub pass_rate: f64,
+    /// Pixel channels tested: those where A, B and both variances are finite.
     pub tested: usize,
     /// z of the difference of the image means, whose variance is Σ(VA + VB) / N²: a sensitive
     /// test for a bias that is small in every pixel but common to all.
@@ -54,15 +60,24 @@ pub fn compare(
     variances: Option<(&Image, &Image)>,
 ) -> Result<Comparison, String> {
     check_same_size(a, b, "A and B")?;
-    let n = (a.pixels.len() * 3).max(1) as f64;
+    let mut n = 0usize;
     let mut squared = 0.0;
     let mut relative = 0.0;
     let mut max_difference = 0.0f64;
     let mut mean_a = [0.0; 3];
     let mut mean_b = [0.0; 3];
+    let mut per_channel = [0usize; 3];
+    let (mut nonfinite_a, mut nonfinite_b) = (0, 0);
     for (pa, pb) in a.pixels.iter().zip(&b.pixels) {
         for c in 0..3 {
             let (x, y) = (pa[c] as f64, pb[c] as f64);
+            nonfinite_a += !x.is_finite() as usize;
+            nonfinite_b += !y.is_finite() as usize;
+            if !(x.is_finite() && y.is_finite()) {
+                continue;
+            }
+            n += 1;
+            per_channel[c] += 1;
             let d = x - y;
             squared += d * d;
             relative += d * d / (y * y + REL_MSE_EPSILON);
@@ -71,7 +86,7 @@ pub fn compare(
             mean_b[c] += y;
         }
     }
-    let pixels = a.pixels.len().max(1) as f64;
+    let n = n.max(1) as f64;
     let z_test = match variances {
         Some((va, vb)) => {
             check_same_size(a, va, "A and its variance")?;
@@ -80,13 +95,17 @@ pub fn compare(
         }
         None => None,
     };
+    let channel_mean =
+        |sums: [f64; 3]| std::array::from_fn(|c| sums[c] / per_channel[c].max(1) as f64);
     Ok(Comparison {
         rmse: (squared / n).sqrt(),
         relative_mse: relative / n,
-        mean_a: mean_a.map(|m| m / pixels),
-        mean_b: mean_b.map(|m| m / pixels),
+        mean_a: channel_mean(mean_a),
+        mean_b: channel_mean(mean_b),
         max_difference,
         z_test,
+        nonfinite_a,
+        nonfinite_b,
     })
 }
 
@@ -97,7 +116,12 @@ fn z_test(a: &Image, b: &Image, va: &Image, vb: &Image) -> ZTest {
     for i in 0..a.pixels.len() {
         for c in 0..3 {
             let d = a.pixels[i][c] as f64 - b.pixels[i][c] as f64;
-            let v = va.pixels[i][c].max(0.0) as f64 + vb.pixels[i][c].max(0.0) as f64;
+            let (var_a, var_b) = (va.pixels[i][c], vb.pixels[i][c]);
+            // f32::max would turn a NaN variance into 0: leave such channels out instead.
+            if !(d.is_finite() && var_a.is_finite() && var_b.is_finite()) {
+                continue;
+            }
+            let v = var_a.max(0.0) as f64 + var_b.max(0.0) as f64;
             diff_sum += d;
             var_sum += v;
             squared_sum += d * d;

@@ -1,8 +1,11 @@
 //! Images: the running mean of a render, written as PNG (display) or EXR (linear radiance).
 //! Every write is atomic: a temporary file in the same folder, then a rename.
 
+use crate::atomic_write::write_atomically;
+use crate::input_file::{read_regular_file, IMAGE_FILE_LIMIT};
 use anyhow::{Context, Result};
-use image::{ImageBuffer, Rgb, Rgb32FImage};
+use image::{ImageBuffer, ImageResult, Rgb, Rgb32FImage};
+use std::io::{Seek, Write};
 use std::path::Path;
 
 /// Linear RGB radiance, row 0 at the top.
@@ -38,20 +41,15 @@ impl ImageFormat {
     }
 }
 
-/// A path an image can be written to: a known format, in a folder that exists. Checked before
-/// rendering, so a bad path fails at once instead of after the render.
+/// A path an image can be written to: a known format, in a folder where files can be created.
+/// Checked before rendering, so a bad path fails at once instead of after the render. A
+/// command with more than one file should use [`crate::output_check::OutputSet`], which also
+/// refuses outputs that are the same file or one of the inputs.
 pub fn check_output_path(path: &Path) -> Result<(), String> {
-    ImageFormat::from_path(path)?;
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(format!(
-                "{}: the output folder {} does not exist",
-                path.display(),
-                dir.display()
-            ));
-        }
-    }
-    Ok(())
+    crate::output_check::OutputSet::new()
+        .image("output", path)
+        .check()
+        .map_err(|e| e.0)
 }
 
 /// The sRGB transfer function of a linear value in [0, 1].
@@ -63,7 +61,11 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
-/// A display byte: clamped to [0, 1], sRGB-encoded, rounded. NaN shows as black.
+/// How a pixel with a NaN channel shows in a PNG: magenta.
+pub const NAN_PIXEL: [u8; 3] = [255, 0, 255];
+
+/// A display byte: clamped to [0, 1], sRGB-encoded, rounded. NaN shows as black here; whole
+/// images mark NaN pixels with [`NAN_PIXEL`] instead ([`Image::to_srgb8`]).
 pub fn srgb_byte(linear: f32) -> u8 {
     let clamped = if linear.is_nan() {
         0.0
@@ -74,51 +76,69 @@ pub fn srgb_byte(linear: f32) -> u8 {
 }
 
 impl Image {
+    /// Display bytes; a pixel with a NaN channel shows as magenta, never as black, so that a
+    /// broken pixel cannot pass for a dark one (renders never produce NaN: see
+    /// `shaders/accumulate.wgsl`).
     pub fn to_srgb8(&self) -> Vec<u8> {
-        self.pixels.iter().flat_map(|p| p.map(srgb_byte)).collect()
+        self.pixels
+            .iter()
+            .flat_map(|p| {
+                if p.iter().any(|c| c.is_nan()) {
+                    NAN_PIXEL
+                } else {
+                    p.map(srgb_byte)
+                }
+            })
+            .collect()
     }
 
-    /// Writes the image atomically; the format comes from the extension.
+    /// Writes the image atomically (see [`crate::atomic_write`]); the format comes from the
+    /// extension.
     pub fn write(&self, path: &Path) -> Result<()> {
         let format = ImageFormat::from_path(path).map_err(anyhow::Error::msg)?;
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        let mut builder = tempfile::Builder::new();
-        builder.prefix(".glint-").suffix(".tmp");
-        // tempfile's default is 0600; an image is an ordinary file (the umask still applies).
-        #[cfg(unix)]
-        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-        let tmp = builder
-            .tempfile_in(dir)
-            .with_context(|| format!("cannot create a temporary file in {}", dir.display()))?;
-        let image_format = match format {
-            ImageFormat::Png => image::ImageFormat::Png,
-            ImageFormat::Exr => image::ImageFormat::OpenExr,
-        };
-        let result = match format {
+        write_atomically(path, |w| self.encode(format, w))
+    }
+
+    /// Encodes the image as `format` into `w`.
+    pub fn encode<W: Write + Seek>(&self, format: ImageFormat, w: &mut W) -> ImageResult<()> {
+        match format {
             ImageFormat::Png => {
                 ImageBuffer::<Rgb<u8>, _>::from_raw(self.width, self.height, self.to_srgb8())
                     .expect("pixel count matches the size")
-                    .save_with_format(tmp.path(), image_format)
+                    .write_to(w, image::ImageFormat::Png)
             }
             ImageFormat::Exr => {
                 let data: Vec<f32> = self.pixels.iter().flatten().copied().collect();
                 Rgb32FImage::from_raw(self.width, self.height, data)
                     .expect("pixel count matches the size")
-                    .save_with_format(tmp.path(), image_format)
+                    .write_to(w, image::ImageFormat::OpenExr)
             }
-        };
-        result.with_context(|| format!("cannot encode {}", path.display()))?;
-        tmp.persist(path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(())
+        }
     }
 
-    /// Reads a linear EXR (as written by [`Image::write`]).
+    /// Reads a linear EXR (as written by [`Image::write`]). Anything else is refused, whatever
+    /// its name: a PNG holds clamped sRGB bytes, and reading it as radiance would compare
+    /// different quantities. Only a regular file up to [`IMAGE_FILE_LIMIT`] is read.
     pub fn read_exr(path: &Path) -> Result<Image> {
-        let img = image::open(path)
+        let bytes = read_regular_file(path, IMAGE_FILE_LIMIT, "image file")
+            .map_err(|m| anyhow::anyhow!("{}: {m}", path.display()))?;
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        match reader.format() {
+            Some(image::ImageFormat::OpenExr) => {}
+            other => {
+                let kind = other.map_or("not an image glint knows".to_string(), |f| {
+                    format!("a {f:?} image")
+                });
+                return Err(anyhow::anyhow!(
+                    "{}: {kind}, not an OpenEXR file; compare needs linear .exr renders (render -o FILE.exr), since a PNG is clamped and sRGB-encoded",
+                    path.display()
+                ));
+            }
+        }
+        let img = reader
+            .decode()
             .with_context(|| format!("cannot read {}", path.display()))?
             .into_rgb32f();
         Ok(Image {

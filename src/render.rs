@@ -2,18 +2,31 @@
 //! each submission stays short (a real GPU's watchdog kills long ones), until the sample
 //! count or the time limit is reached.
 
+use crate::accumulation::Accumulation;
 use crate::aov::Aovs;
+use crate::cpu::accumulate::next_block_end;
 use crate::output::Image;
 use anyhow::{anyhow, Result};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// A device that accumulates per-pixel radiance statistics.
 pub trait Renderer {
     /// Adds `count` samples to every pixel. Their global sample indices continue from
-    /// [`Renderer::samples`], and the random stream depends on the index, never on the batching.
+    /// [`Renderer::first_sample`] + [`Renderer::samples`], and the random stream depends on the
+    /// index, never on the batching.
     fn add_samples(&mut self, count: u32) -> Result<()>;
     /// Samples per pixel accumulated so far.
     fn samples(&self) -> u32;
+    /// The global index of the first accumulated sample: 0, or where a partial render
+    /// (`--samples A..B`) or a resumed one starts.
+    fn first_sample(&self) -> u32;
+    /// The accumulators: mean and M2 over [`Renderer::samples`] samples per pixel.
+    fn read_accumulation(&mut self) -> Result<Accumulation>;
+    /// Replaces the accumulators with `state`, the statistics of the global samples
+    /// `first_sample..first_sample + state.count` (none: empty); later samples continue after
+    /// them.
+    fn load_accumulation(&mut self, first_sample: u32, state: Option<&Accumulation>) -> Result<()>;
     /// The mean radiance per pixel.
     fn read_mean(&mut self) -> Result<Image>;
     /// The variance of each pixel's mean estimate (σ²/n per channel, from the unbiased sample
@@ -24,7 +37,7 @@ pub trait Renderer {
     fn read_aovs(&mut self) -> Result<Aovs> {
         Err(anyhow!("this renderer does not accumulate AOVs"))
     }
-    /// Forgets all samples.
+    /// Forgets all samples (the first sample stays where it was).
     fn reset(&mut self) -> Result<()>;
     /// Ray segments traced since the last reset (camera, bounce and shadow rays), where the
     /// renderer counts them (the GPU one only when instrumented).
@@ -36,9 +49,30 @@ pub trait Renderer {
     fn last_kernel_time(&self) -> Option<Duration> {
         None
     }
+    /// Samples dropped since the last reset because they were NaN, infinite or too large
+    /// (`shaders/accumulate.wgsl`); each counted as black.
+    fn nonfinite_samples(&self) -> u64;
     /// Adapter name, or "cpu".
     fn device_name(&self) -> String;
     fn backend_name(&self) -> String;
+}
+
+/// Refuses an accumulation whose image size is not the renderer's.
+pub fn check_size(params: &crate::shader_types::Params, state: &Accumulation) -> Result<()> {
+    let pixels = params.width as usize * params.height as usize;
+    if (state.width, state.height) != (params.width, params.height)
+        || state.mean.len() != pixels
+        || state.m2.len() != pixels
+    {
+        anyhow::bail!(
+            "cannot load a {}×{} accumulation into a {}×{} render",
+            state.width,
+            state.height,
+            params.width,
+            params.height
+        );
+    }
+    Ok(())
 }
 
 /// σ²/n per channel from M2 over n samples: M2 / (n − 1) / n.
@@ -88,6 +122,8 @@ pub enum StopReason {
     SamplesReached,
     TimeLimit,
     TargetError,
+    /// SIGINT or SIGTERM (see [`StopRules::interrupted`]).
+    Interrupted,
 }
 
 impl StopReason {
@@ -96,6 +132,7 @@ impl StopReason {
             StopReason::SamplesReached => "spp",
             StopReason::TimeLimit => "time-limit",
             StopReason::TargetError => "target-error",
+            StopReason::Interrupted => "interrupted",
         }
     }
 }
@@ -119,6 +156,8 @@ pub struct StopRules {
     pub time_limit: Option<Duration>,
     /// Stop at the first batch boundary where [`relative_error`] ≤ this.
     pub target_error: Option<f64>,
+    /// Stop before the next batch once this is set (by a signal handler).
+    pub interrupted: Option<&'static AtomicBool>,
 }
 
 /// The state after each batch, for progress reports and checkpoints.
@@ -156,7 +195,20 @@ pub fn render_progressive(
     let mut stop_reason = StopReason::SamplesReached;
     let mut error = None;
     while renderer.samples() < spp {
-        let count = sizer.spp_per_batch.min(spp - renderer.samples());
+        if rules
+            .interrupted
+            .is_some_and(|flag| flag.load(Ordering::Relaxed))
+        {
+            stop_reason = StopReason::Interrupted;
+            break;
+        }
+        // Batches end only where the merge schedule's blocks do, so the image's bytes do not
+        // depend on the batch sizes, which follow the wall clock (src/cpu/accumulate.rs). The
+        // blocks are of global sample indices, so a partial render's batches end where a
+        // single render's would.
+        let first = renderer.first_sample();
+        let done = first + renderer.samples();
+        let count = next_block_end(done, sizer.spp_per_batch, first + spp) - done;
         let batch_start = Instant::now();
         renderer.add_samples(count)?;
         let took = batch_start.elapsed();
@@ -202,11 +254,13 @@ pub fn render_progressive(
     })
 }
 
-/// Adds samples until there are `spp`, in batches of `batch`, and returns the mean image: the
+/// Adds samples until there are `spp`, in batches of about `batch` (rounded up to the merge
+/// schedule's block ends, like [`render_progressive`]'s), and returns the mean image: the
 /// simple path for tests and tools that want no progress reporting.
 pub fn render_image(renderer: &mut dyn Renderer, spp: u32, batch: u32) -> Result<Image> {
     while renderer.samples() < spp {
-        renderer.add_samples(batch.max(1).min(spp - renderer.samples()))?;
+        let done = renderer.samples();
+        renderer.add_samples(next_block_end(done, batch, spp) - done)?;
     }
     renderer.read_mean()
 }

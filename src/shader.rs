@@ -8,14 +8,20 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 8] = [
+pub const SHADER_PARTS: [(&str, &str); 11] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
+    ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
+    (
+        "accumulate.wgsl",
+        include_str!("../shaders/accumulate.wgsl"),
+    ),
+    ("tiles.wgsl", include_str!("../shaders/tiles.wgsl")),
     ("trace.wgsl", include_str!("../shaders/trace.wgsl")),
 ];
 

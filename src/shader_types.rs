@@ -33,10 +33,14 @@ pub struct Params {
     pub emitter_count: u32,
     /// Russian roulette after the scattering at this bounce and later ones (`ROULETTE_OFF`: off).
     pub roulette_start: u32,
-    /// Firefly clamp: the most a contribution of scattered light may add (0: off).
-    pub radiance_clamp: f32,
+    /// Samples already in the accumulators (the pairwise merge's n_old): `sample_start` less
+    /// the first sample of a partial render (`--samples A..B`), which need not start at 0.
+    pub accumulated_samples: u32,
     /// 1: accumulate the denoiser's albedo, normal and depth; needs `KernelFeatures::aovs`.
     pub aovs: u32,
+    /// Firefly clamp: the most a contribution of scattered light may add (0: off).
+    pub radiance_clamp: f32,
+    pub _pad: [u32; 3],
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.

@@ -2,9 +2,9 @@
 
 use glam::Vec3;
 use glint::cpu::intersect::{
-    closest_primitive, first_hit_is, hit_quad, hit_sphere, intersect_scene, offset_ray_origin,
-    NO_HIT,
+    closest_primitive, first_hit_is, hit_quad, hit_sphere, intersect_scene, NO_HIT,
 };
+use glint::cpu::surface::{offset_ray_origin, sphere_point};
 use glint::cpu::Ray;
 use glint::scene::{Material, MaterialKind, Quad as SceneQuad, Scene};
 use glint::shader_types::{Quad, Sphere};
@@ -237,11 +237,11 @@ fn offset_origin_prevents_self_intersection_at_every_scale() {
             let z = 1.0 - 2.0 * (i as f32 + 0.5) / 2000.0;
             let r = (1.0 - z * z).sqrt();
             let n = Vec3::new(r * a.cos(), r * a.sin(), z);
-            let p = Vec3::from(center) + radius * n;
+            let p = sphere_point(Vec3::from(center), radius, n);
             let tangentish = n.any_orthonormal_vector();
             let dir = (tangentish + 0.05 * n).normalize();
             let out = Ray {
-                origin: offset_ray_origin(p, n),
+                origin: offset_ray_origin(p.position, p.error, n),
                 dir,
             };
             if hit_sphere(&s, &out) != NO_HIT {

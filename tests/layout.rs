@@ -99,8 +99,9 @@ fn rust_structs_match_wgsl_layout() {
             material_count,
             emitter_count,
             roulette_start,
+            accumulated_samples,
+            aovs,
             radiance_clamp,
-            aovs
         ]
     );
     assert_same_layout!(

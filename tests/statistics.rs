@@ -193,6 +193,7 @@ fn target_error_stops_with_the_real_error_near_the_target() {
         glint::render::StopRules {
             time_limit: None,
             target_error: Some(target),
+            ..Default::default()
         },
         &mut glint::render::BatchSizer::new(std::time::Duration::from_millis(50)),
         |_, _| Ok(()),

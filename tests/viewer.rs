@@ -453,3 +453,60 @@ fn bad_view_input_is_reported_before_any_window() {
         assert!(!stderr.contains("no display"), "{args:?}: {stderr}");
     }
 }
+
+/// Issue 15, item 10: the scene file replaced by a FIFO (whose open() blocks until a writer
+/// comes) or by a link to /dev/zero (which never ends) must not freeze the window: the reload
+/// fails with a clear error and frames keep coming.
+#[test]
+fn a_scene_replaced_by_a_fifo_or_dev_zero_does_not_freeze_the_window() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("box.toml");
+    std::fs::copy(scene_path("cornell.toml"), &scene).unwrap();
+    let (mut child, rx) = spawn_with_log(view_command(
+        &x,
+        dir.path(),
+        &[
+            "box.toml",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp-per-frame",
+            "1",
+        ],
+    ));
+    let is_frame = |v: &Value| v.get("frame").is_some() && v.get("event").is_none();
+    wait_for(&rx, "a first frame", is_frame);
+    type MakeSpecialFile<'a> = &'a dyn Fn(&Path);
+    let replacements: [(&str, MakeSpecialFile); 2] = [
+        ("FIFO", &|tmp: &Path| {
+            let c_path = std::ffi::CString::new(tmp.to_str().unwrap()).unwrap();
+            // SAFETY: a valid NUL-terminated path.
+            assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o600) }, 0);
+        }),
+        ("character device", &|tmp: &Path| {
+            std::os::unix::fs::symlink("/dev/zero", tmp).unwrap();
+        }),
+    ];
+    for (needle, make) in replacements {
+        let tmp = dir.path().join("new.tmp");
+        make(&tmp);
+        std::fs::rename(&tmp, &scene).unwrap();
+        let reload = wait_for(&rx, "the failed reload", |v| v["event"] == "reload");
+        let error = reload.last().unwrap()["error"]
+            .as_str()
+            .unwrap()
+            .to_string();
+        assert!(error.contains(needle), "{error}");
+        // Frames go on after it.
+        for _ in 0..3 {
+            wait_for(&rx, "frames after the reload", is_frame);
+        }
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+}

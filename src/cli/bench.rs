@@ -48,7 +48,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     };
     let gpu_name = gpu.as_ref().map(|g| g.device_name());
     if !args.json {
-        println!(
+        crate::outln!(
             "GPU: {}   CPU reference: {} threads   (medians of {} runs after a warm-up)",
             gpu_name.as_deref().unwrap_or("none"),
             rayon::current_num_threads(),
@@ -82,9 +82,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         };
         if !args.json {
             if results.is_empty() {
-                println!("{}", header());
+                crate::outln!("{}", header());
             }
-            println!("{}", row(&result));
+            crate::outln!("{}", row(&result));
         }
         results.push(result);
     }
@@ -110,7 +110,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 })
             })
             .collect();
-        println!(
+        crate::outln!(
             "{}",
             serde_json::json!({
                 "gpu": gpu_name,

@@ -2,7 +2,8 @@
 
 use crate::compare::{compare, difference_image, Z_CRITICAL, Z_TEST_ALPHA};
 use crate::error::InputError;
-use crate::output::{check_output_path, Image};
+use crate::output::Image;
+use crate::output_check::OutputSet;
 use anyhow::Result;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -33,9 +34,13 @@ fn read(path: &Path) -> Result<Image, InputError> {
 }
 
 pub fn run(args: CompareArgs) -> Result<()> {
-    if let Some(diff) = &args.diff {
-        check_output_path(diff).map_err(InputError)?;
-    }
+    OutputSet::new()
+        .input("A", &args.a)
+        .input("B", &args.b)
+        .input_opt("--variance-a", args.variance_a.as_deref())
+        .input_opt("--variance-b", args.variance_b.as_deref())
+        .image_opt("--diff", args.diff.as_deref())
+        .check()?;
     let a = read(&args.a)?;
     let b = read(&args.b)?;
     let variances = match (&args.variance_a, &args.variance_b) {
@@ -44,6 +49,13 @@ pub fn run(args: CompareArgs) -> Result<()> {
     };
     let variance_refs = variances.as_ref().map(|(va, vb)| (va, vb));
     let c = compare(&a, &b, variance_refs).map_err(InputError)?;
+    if c.nonfinite_a + c.nonfinite_b > 0 {
+        crate::errln!(
+            "glint: warning: non-finite (NaN or infinite) pixel channels: {} in A, {} in B; they are left out of every figure",
+            c.nonfinite_a,
+            c.nonfinite_b
+        );
+    }
     if let Some(diff) = &args.diff {
         difference_image(&a, &b, variance_refs).write(diff)?;
     }
@@ -57,7 +69,7 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 "variance_ratio": z.variance_ratio,
             })
         });
-        println!(
+        crate::outln!(
             "{}",
             serde_json::json!({
                 "a": args.a.display().to_string(),
@@ -69,34 +81,45 @@ pub fn run(args: CompareArgs) -> Result<()> {
                 "mean_a": c.mean_a,
                 "mean_b": c.mean_b,
                 "max_difference": c.max_difference,
+                "nonfinite_a": c.nonfinite_a,
+                "nonfinite_b": c.nonfinite_b,
                 "z_test": z,
             })
         );
         return Ok(());
     }
-    println!(
+    crate::outln!(
         "A: {}  B (reference): {}  ({}×{})",
         args.a.display(),
         args.b.display(),
         a.width,
         a.height
     );
-    println!("RMSE            {:.6}", c.rmse);
-    println!(
+    crate::outln!("RMSE            {:.6}", c.rmse);
+    crate::outln!(
         "relative MSE    {:.6}   (mean of (A−B)² / (B² + 0.01))",
         c.relative_mse
     );
-    println!(
+    crate::outln!(
         "mean A (RGB)    {:.6} {:.6} {:.6}",
-        c.mean_a[0], c.mean_a[1], c.mean_a[2]
+        c.mean_a[0],
+        c.mean_a[1],
+        c.mean_a[2]
     );
-    println!(
+    crate::outln!(
         "mean B (RGB)    {:.6} {:.6} {:.6}",
-        c.mean_b[0], c.mean_b[1], c.mean_b[2]
+        c.mean_b[0],
+        c.mean_b[1],
+        c.mean_b[2]
     );
-    println!("max |A−B|       {:.6}", c.max_difference);
+    crate::outln!("max |A−B|       {:.6}", c.max_difference);
+    crate::outln!(
+        "non-finite      A {}  B {}   (NaN or infinite pixel channels, left out of the figures)",
+        c.nonfinite_a,
+        c.nonfinite_b
+    );
     if let Some(z) = &c.z_test {
-        println!(
+        crate::outln!(
             "Z-test          {:.2}% of {} pixel channels pass |z| ≤ {:.3} (α = {}; expect about {:.0}% for matching renders)",
             100.0 * z.pass_rate,
             z.tested,
@@ -104,11 +127,11 @@ pub fn run(args: CompareArgs) -> Result<()> {
             Z_TEST_ALPHA,
             100.0 * (1.0 - Z_TEST_ALPHA)
         );
-        println!(
+        crate::outln!(
             "z of the means  {:.3}   (|z| > 4 is a significant overall bias)",
             z.z_of_means
         );
-        println!(
+        crate::outln!(
             "variance ratio  {:.3}   (mean (A−B)² / mean (VA+VB); 1 when variances are honest)",
             z.variance_ratio
         );

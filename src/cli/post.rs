@@ -3,7 +3,8 @@
 
 use crate::denoise;
 use crate::error::InputError;
-use crate::output::{check_output_path, Image, ImageFormat};
+use crate::output::{Image, ImageFormat};
+use crate::output_check::OutputSet;
 use crate::render::Renderer;
 use crate::shader_types::Params;
 use crate::tonemap::{parse_exposure, DisplayTransform, Tonemap};
@@ -72,38 +73,43 @@ impl PostArgs {
         self.denoise || self.aov_outputs().iter().any(|(_, p)| p.is_some())
     }
 
-    /// Checks every extra output path (exit 2 when bad) and, for --denoise, that OIDN loads
-    /// (exit 1 with the install step when not), all before rendering. `others` are the
-    /// command's other output files, which no extra output may overwrite.
-    pub fn check(&self, others: &[&Path]) -> Result<()> {
-        let mut seen: Vec<&Path> = others.to_vec();
-        let extra = self
-            .aov_outputs()
+    /// Adds the extra outputs to the command's [`OutputSet`], so they are checked together
+    /// with the others (format, folder, same file twice, an output that is an input).
+    pub fn outputs(&self, set: OutputSet) -> OutputSet {
+        self.aov_outputs()
             .into_iter()
-            .chain([("--raw", self.raw.as_ref())]);
-        for (flag, path) in extra {
-            let Some(path) = path else { continue };
-            check_output_path(path).map_err(InputError)?;
-            if ImageFormat::from_path(path) != Ok(ImageFormat::Exr) {
-                return Err(InputError(format!(
-                    "{}: {flag} needs an .exr file (linear floats)",
-                    path.display()
-                ))
-                .into());
-            }
-            if seen.contains(&path.as_path()) {
-                return Err(InputError(format!(
-                    "{}: {flag} names a file another output already writes",
-                    path.display()
-                ))
-                .into());
-            }
-            seen.push(path);
+            .chain([("--raw", self.raw.as_ref())])
+            .fold(set, |set, (flag, path)| {
+                set.exr_opt(flag, path.map(|p| p.as_path()))
+            })
+    }
+
+    /// Refuses AOVs and --denoise on a partial or resumed render (exit 2): the AOV means are
+    /// not kept in partial files, so they would cover only this run's samples.
+    pub fn refuse_partial(&self, partial_or_resumed: bool) -> Result<()> {
+        if partial_or_resumed && self.needs_aovs() {
+            return Err(InputError(
+                "--denoise, --albedo, --normal and --depth need a whole render: they cannot be \
+                 combined with --samples, --shard or --resume"
+                    .into(),
+            )
+            .into());
         }
+        Ok(())
+    }
+
+    /// For --denoise, checks that OIDN loads (exit 1 with the install step when not), before
+    /// rendering.
+    pub fn check(&self) -> Result<()> {
         if self.denoise {
             denoise::oidn()?;
         }
         Ok(())
+    }
+
+    /// How PNG output is shown.
+    pub fn display_transform(&self) -> DisplayTransform {
+        self.display()
     }
 
     /// Sets what the kernel needs: AOVs and the firefly clamp.
@@ -123,8 +129,8 @@ impl PostArgs {
             .with_context(|| format!("writing {}", path.display()))
     }
 
-    /// Writes the final output (denoised with --denoise, else `mean`), the raw mean and the
-    /// AOVs. Returns the seconds spent denoising, with --denoise.
+    /// With --denoise, writes the denoised `mean` to `output` (the raw mean is the render
+    /// writer's, at --raw); writes the AOVs. Returns the seconds spent denoising, with --denoise.
     pub fn finish(
         &self,
         renderer: &mut dyn Renderer,
@@ -137,17 +143,11 @@ impl PostArgs {
             None
         };
         let mut denoise_seconds = None;
-        match (&aovs, self.denoise) {
-            (Some(aovs), true) => {
-                let started = Instant::now();
-                let denoised = denoise::oidn()?.denoise(mean, aovs)?;
-                denoise_seconds = Some(started.elapsed().as_secs_f64());
-                self.write_output(&denoised, output)?;
-            }
-            _ => self.write_output(mean, output)?,
-        }
-        if let Some(raw) = &self.raw {
-            self.write_output(mean, raw)?;
+        if let (Some(aovs), true) = (&aovs, self.denoise) {
+            let started = Instant::now();
+            let denoised = denoise::oidn()?.denoise(mean, aovs)?;
+            denoise_seconds = Some(started.elapsed().as_secs_f64());
+            self.write_output(&denoised, output)?;
         }
         if let Some(aovs) = &aovs {
             for (image, (_, path)) in [&aovs.albedo, &aovs.normal, &aovs.depth]

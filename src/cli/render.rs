@@ -1,21 +1,26 @@
 //! `glint render`.
 
 use super::post::PostArgs;
+use super::render_writer::RenderWriter;
+use super::sample_range::{self, SampleRangeArgs};
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer};
-use crate::output::{check_output_path, ImageFormat};
-use crate::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
+use crate::interrupt::{self, Interrupted};
+use crate::output::ImageFormat;
+use crate::output_check::OutputSet;
+use crate::partial::{format_range, settings_hash, PartialInfo};
+use crate::render::{
+    relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
+};
 use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// How often the output file is refreshed with the running image.
-const CHECKPOINT_INTERVAL: Duration = Duration::from_secs(3);
 /// Wanted duration of one GPU submission: short enough for a desktop GPU's watchdog and a
 /// responsive progress bar, long enough that per-batch overhead stays small.
 const BATCH_TARGET: Duration = Duration::from_millis(250);
@@ -52,15 +57,16 @@ pub struct RenderArgs {
     #[arg(long)]
     pub gpu: bool,
     /// Stop at the first batch boundary after this many seconds and write what is done.
-    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
     /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr.
     #[arg(long, value_name = "FILE.exr")]
     pub variance: Option<PathBuf>,
     /// Stop at the first batch boundary where the image's relative standard error,
     /// √(mean of the variance image) / (mean of the image), is at most E (checked from 8 spp on).
-    /// --spp is then the upper bound, and --time-limit still holds.
-    #[arg(long, value_name = "E", value_parser = parse_target_error)]
+    /// --spp is then the upper bound, and --time-limit still holds. On a black image (mean 0)
+    /// the relative error is undefined, so it never stops the render (a note says so).
+    #[arg(long, value_name = "E", value_parser = parse_target_error, allow_negative_numbers = true)]
     pub target_error: Option<f64>,
     /// Print a JSON summary on stdout at the end. Its "seconds" is the time spent rendering
     /// batches only: start-up, scene upload, shader compilation and file writes are not in it
@@ -69,14 +75,25 @@ pub struct RenderArgs {
     pub json: bool,
     #[command(flatten)]
     pub post: PostArgs,
+    #[command(flatten)]
+    pub range: SampleRangeArgs,
+    /// Refresh the output with the running image (a resumable partial file for .exr) every
+    /// this many seconds; 0: after every batch.
+    #[arg(long, value_name = "SECONDS", value_parser = sample_range::parse_interval, default_value = "3")]
+    pub checkpoint_interval: Duration,
 }
+
+/// Longest `--time-limit`: about 31 years, far inside what a `Duration` holds (1.8e19 s).
+const MAX_TIME_LIMIT_SECONDS: f64 = 1e9;
 
 fn parse_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s
         .parse()
         .map_err(|_| format!("{s:?} is not a number of seconds"))?;
-    if !v.is_finite() || v < 0.0 {
-        return Err(format!("must be a finite number ≥ 0, got {s}"));
+    if !(0.0..=MAX_TIME_LIMIT_SECONDS).contains(&v) {
+        return Err(format!(
+            "must be a number of seconds in [0, {MAX_TIME_LIMIT_SECONDS:e}], got {s}"
+        ));
     }
     Ok(v)
 }
@@ -97,11 +114,6 @@ fn parse_target_error(s: &str) -> Result<f64, String> {
     Ok(v)
 }
 
-fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene.file_stem().unwrap_or_else(|| "render".as_ref());
-    PathBuf::from(stem).with_extension("png")
-}
-
 /// Either a GPU renderer or, where there is none, the CPU reference.
 fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
     if args.cpu {
@@ -111,7 +123,7 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
         Ok(ctx) => Ok(Some(ctx)),
         Err(e) if args.gpu => Err(anyhow::Error::new(e).context("--gpu was given")),
         Err(e) => {
-            eprintln!("glint: {e}; rendering on the CPU reference instead");
+            crate::errln!("glint: {e}; rendering on the CPU reference instead");
             Ok(None)
         }
     }
@@ -131,40 +143,67 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let scene = scene
         .with_overrides(&overrides)
         .map_err(|m| InputError(format!("{}: {m}", args.scene.display())))?;
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| default_output(&args.scene));
-    check_output_path(&output).map_err(InputError)?;
-    if let Some(variance) = &args.variance {
-        check_output_path(variance).map_err(InputError)?;
-        if ImageFormat::from_path(variance) != Ok(ImageFormat::Exr) {
-            return Err(InputError(format!(
-                "{}: --variance needs an .exr file (linear floats)",
-                variance.display()
-            ))
-            .into());
-        }
-    }
-    let main_outputs: Vec<&Path> = [Some(&output), args.variance.as_ref()]
-        .into_iter()
-        .flatten()
-        .map(|p| p.as_path())
-        .collect();
-    args.post.check(&main_outputs)?;
-
+    let range = &args.range;
+    args.post.refuse_partial(
+        range.samples.is_some() || range.shard.is_some() || range.resume.is_some(),
+    )?;
     let mut kernel_scene = scene.kernel_scene();
     args.post.configure(&mut kernel_scene.params);
+    let settings = &scene.render;
+    let (width, height) = (settings.width, settings.height);
+    let settings_hash = settings_hash(&kernel_scene);
+    let plan = sample_range::plan(&args.range, settings.spp, &settings_hash, (width, height))?;
+    let output = args.output.clone().unwrap_or_else(|| {
+        sample_range::default_output(&args.scene, &plan, &args.range, settings.spp)
+    });
+    let outputs = OutputSet::new()
+        .input("the scene file", &args.scene)
+        .image("-o", &output)
+        .exr_opt("--variance", args.variance.as_deref());
+    args.post.outputs(outputs).check()?;
+    if plan.is_partial(settings.spp) && ImageFormat::from_path(&output) != Ok(ImageFormat::Exr) {
+        return Err(InputError(format!(
+            "{}: a partial render (samples {} of {}) needs an .exr output to hold what a merge needs",
+            output.display(),
+            format_range(&plan.target),
+            settings.spp
+        ))
+        .into());
+    }
+    args.post.check()?;
+
     let gpu = open_gpu(&args)?;
     let mut renderer: Box<dyn Renderer + '_> = match &gpu {
         Some(ctx) => Box::new(GpuRenderer::new(ctx, &kernel_scene)?),
         None => Box::new(CpuRenderer::new(&kernel_scene)),
     };
 
-    let settings = &scene.render;
-    let (width, height) = (settings.width, settings.height);
+    plan.start(renderer.as_mut())?;
+    // With --denoise, -o is the denoised image, written at the end; the mean goes to --raw.
+    let writer_output = if args.post.denoise {
+        args.post.raw.clone()
+    } else {
+        Some(output.clone())
+    };
+    let mut writer = RenderWriter::new(
+        writer_output,
+        args.variance.clone(),
+        args.post.display_transform(),
+        PartialInfo {
+            ranges: Vec::new(),
+            target: plan.target.clone(),
+            spp: settings.spp,
+            seed: settings.seed,
+            settings: settings_hash,
+            scene: args.scene.display().to_string(),
+            device: renderer.device_name(),
+        },
+    );
     let progress = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(settings.spp as u64), ProgressDrawTarget::stderr())
+        ProgressBar::with_draw_target(
+            Some(plan.samples_wanted() as u64),
+            ProgressDrawTarget::stderr(),
+        )
     } else {
         ProgressBar::hidden()
     };
@@ -178,10 +217,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let rules = StopRules {
         time_limit: args.time_limit.map(Duration::from_secs_f64),
         target_error: args.target_error,
+        interrupted: Some(interrupt::install()?),
     };
     let stats = render_progressive(
         renderer.as_mut(),
-        settings.spp,
+        plan.samples_wanted(),
         rules,
         &mut sizer,
         |r, report| {
@@ -193,27 +233,36 @@ pub fn run(args: RenderArgs) -> Result<()> {
             }
             progress.set_message(message);
             if report.spp_done < report.spp_target
-                && last_checkpoint.elapsed() >= CHECKPOINT_INTERVAL
+                && last_checkpoint.elapsed() >= args.checkpoint_interval
             {
-                args.post.write_output(&r.read_mean()?, &output)?;
+                writer.checkpoint(r)?;
                 last_checkpoint = Instant::now();
             }
             Ok(())
         },
     )?;
     progress.finish_and_clear();
-    let mean = renderer.read_mean()?;
-    let variance = renderer.read_variance()?;
-    let denoise_seconds = args.post.finish(renderer.as_mut(), &mean, &output)?;
-    if let Some(path) = &args.variance {
-        variance
-            .write(path)
-            .with_context(|| format!("writing {}", path.display()))?;
+    if args.target_error.is_some() && stats.relative_error.is_none() {
+        crate::errln!(
+            "glint: note: --target-error never applied: the image is black (or below {MIN_SPP_FOR_TARGET_ERROR} spp), so its relative error is undefined"
+        );
     }
+    let (mean, variance) = writer.finish(renderer.as_mut())?;
+    let denoise_seconds = args.post.finish(renderer.as_mut(), &mean, &output)?;
+    let first = renderer.first_sample();
 
+    let nonfinite = renderer.nonfinite_samples();
+    if nonfinite > 0 {
+        crate::errln!(
+            "glint: warning: {nonfinite} samples were NaN, infinite or above 1e14 and were \
+             dropped (counted as black)"
+        );
+    }
     if args.json {
         let seconds = stats.render_time.as_secs_f64();
-        let paths = pixels as u64 * stats.spp as u64;
+        // This run's paths only, not a resumed file's.
+        let resumed = plan.resumed.as_ref().map_or(0, |p| p.accumulation.count);
+        let paths = pixels as u64 * (stats.spp - resumed) as u64;
         let summary = serde_json::json!({
             "scene": args.scene.display().to_string(),
             "output": output.display().to_string(),
@@ -227,12 +276,28 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "paths_per_second": paths as f64 / seconds.max(1e-9),
             "wall_seconds": started.elapsed().as_secs_f64(),
             "stopped_by": stats.stop_reason.as_str(),
-            "relative_error": relative_error(&mean, &variance),
+            // Below 2 spp there is no variance estimate: the error is unknown (null), not 0.
+            "relative_error": (stats.spp >= 2).then(|| relative_error(&mean, &variance)).flatten(),
+            "nonfinite_samples": renderer.nonfinite_samples(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
             "denoise_seconds": denoise_seconds,
+            "samples": [first, first + stats.spp],
         });
-        println!("{summary}");
+        crate::outln!("{summary}");
+    }
+    if let Some(signal) = interrupt::requested() {
+        return Err(Interrupted {
+            signal,
+            message: format!(
+                "interrupted by {} at {} spp; wrote samples {} to {} (continue with --resume)",
+                interrupt::name(signal),
+                stats.spp,
+                format_range(&(first..first + stats.spp)),
+                output.display()
+            ),
+        }
+        .into());
     }
     Ok(())
 }

@@ -1,17 +1,19 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
+use super::surface::{parametric_point, sphere_point};
 use super::Ray;
 use crate::shader_types::{Quad, Sphere, PRIMITIVE_QUAD, PRIMITIVE_SPHERE};
-use glam::{BVec3, IVec3, Vec3};
+use glam::Vec3;
 
 pub const NO_HIT: f32 = 3.402823e38;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
     pub t: f32,
-    /// The hit point; on spheres projected back onto the surface, so errors cannot build up
-    /// over many bounces.
+    /// The hit point, put back on the surface (`surface.rs`), so errors cannot build up over
+    /// many bounces, and a bound on its rounding error per coordinate.
     pub position: Vec3,
+    pub error: Vec3,
     /// Geometric normal, unit length, facing against the incoming ray.
     pub normal: Vec3,
     pub material: u32,
@@ -129,6 +131,7 @@ pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
         return Hit {
             t: NO_HIT,
             position: Vec3::ZERO,
+            error: Vec3::ZERO,
             normal: Vec3::ZERO,
             material: 0,
             front_face: false,
@@ -136,53 +139,43 @@ pub fn intersect_scene(spheres: &[Sphere], quads: &[Quad], ray: &Ray) -> Hit {
             index: 0,
         };
     }
-    let (outward, position, material) = if closest.primitive == PRIMITIVE_SPHERE {
+    let (outward, surface, material) = if closest.primitive == PRIMITIVE_SPHERE {
         let s = &spheres[closest.index as usize];
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
         let outward = (ray.origin + closest.t * ray.dir - Vec3::from(s.center)).normalize();
         (
             outward,
-            Vec3::from(s.center) + s.radius * outward,
+            sphere_point(Vec3::from(s.center), s.radius, outward),
             s.material,
         )
     } else {
         let q = &quads[closest.index as usize];
+        // On the plane through corner, edge_u and edge_v: the hit test's a and b, clamped.
+        let w = ray.origin + closest.t * ray.dir - Vec3::from(q.corner);
+        let a = Vec3::from(q.u_dual).dot(w).clamp(0.0, 1.0);
+        let b = Vec3::from(q.v_dual).dot(w).clamp(0.0, 1.0);
         (
             Vec3::from(q.normal),
-            ray.origin + closest.t * ray.dir,
+            parametric_point(
+                Vec3::from(q.corner),
+                Vec3::from(q.edge_u),
+                Vec3::from(q.edge_v),
+                a,
+                b,
+            ),
             q.material,
         )
     };
     let front_face = outward.dot(ray.dir) < 0.0;
     Hit {
         t: closest.t,
-        position,
+        position: surface.position,
+        error: surface.error,
         normal: if front_face { outward } else { -outward },
         material,
         front_face,
         primitive: closest.primitive,
         index: closest.index,
     }
-}
-
-/// Moves a surface point off the surface along `n`, by a few ulps of its own magnitude, so the
-/// next ray cannot hit the surface it leaves, at any scene scale (Wächter and Binder,
-/// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, 2019).
-pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
-    let of_i = (256.0 * n).as_ivec3();
-    let bits = IVec3::new(
-        p.x.to_bits() as i32,
-        p.y.to_bits() as i32,
-        p.z.to_bits() as i32,
-    );
-    let step = IVec3::select(p.cmplt(Vec3::ZERO), -of_i, of_i);
-    let moved = bits.wrapping_add(step);
-    let p_i = Vec3::new(
-        f32::from_bits(moved.x as u32),
-        f32::from_bits(moved.y as u32),
-        f32::from_bits(moved.z as u32),
-    );
-    let near_origin: BVec3 = p.abs().cmplt(Vec3::splat(1.0 / 32.0));
-    Vec3::select(near_origin, p + (1.0 / 65536.0) * n, p_i)
 }

@@ -156,12 +156,27 @@ pub fn light_pdf(
     s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p))
 }
 
-/// Veach's power heuristic (β = 2) for the sample drawn with pdf `a` against pdf `b`.
+/// Veach's power heuristic (β = 2) for the sample drawn with pdf `a` against pdf `b`:
+/// a² / (a² + b²), written with the ratio of the smaller pdf to the larger so that nothing
+/// overflows (a light pdf can exceed 10¹⁹, whose square is infinite in f32). Infinite pdfs (a
+/// light too small or too grazing to sample) are taken as the largest finite ones.
 pub fn power_heuristic(a: f32, b: f32) -> f32 {
-    let a2 = a * a;
-    let b2 = b * b;
-    if a2 + b2 == 0.0 {
+    // Written to reject NaN as the WGSL does.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(a > 0.0) {
         return 0.0;
     }
-    a2 / (a2 + b2)
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if !(b > 0.0) {
+        return 1.0;
+    }
+    let a_max = a.min(f32::MAX);
+    let b_max = b.min(f32::MAX);
+    if a_max >= b_max {
+        let r = b_max / a_max;
+        return 1.0 / (1.0 + r * r);
+    }
+    let r = a_max / b_max;
+    let r2 = r * r;
+    r2 / (1.0 + r2)
 }

@@ -2,6 +2,7 @@
 //! names, the same random stream and the same f32 operations. It is the oracle for the GPU
 //! and the fallback where there is no Vulkan device.
 
+pub mod accumulate;
 pub mod aov;
 pub mod camera;
 pub mod intersect;
@@ -9,6 +10,7 @@ pub mod lights;
 pub mod material;
 pub mod renderer;
 pub mod rng;
+pub mod surface;
 pub mod trace;
 
 use glam::Vec3;

@@ -1,9 +1,10 @@
 //! The CPU renderer: the kernel's entry point run over all pixels, rows in parallel (rayon).
 
 use super::trace::{render_pixel, PixelStats, SceneRefs};
+use crate::accumulation::Accumulation;
 use crate::aov::Aovs;
 use crate::output::Image;
-use crate::render::{variance_of_mean, Renderer};
+use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use anyhow::{anyhow, Result};
 use rayon::prelude::*;
@@ -12,6 +13,7 @@ pub struct CpuRenderer {
     scene: KernelScene,
     stats: Vec<PixelStats>,
     samples: u32,
+    first_sample: u32,
     segments: u64,
 }
 
@@ -22,6 +24,7 @@ impl CpuRenderer {
             scene: scene.clone(),
             stats: vec![PixelStats::default(); pixels],
             samples: 0,
+            first_sample: 0,
             segments: 0,
         }
     }
@@ -38,7 +41,8 @@ impl CpuRenderer {
 impl Renderer for CpuRenderer {
     fn add_samples(&mut self, count: u32) -> Result<()> {
         let mut params = self.scene.params;
-        params.sample_start = self.samples;
+        params.sample_start = self.first_sample + self.samples;
+        params.accumulated_samples = self.samples;
         params.sample_count = count;
         let refs = SceneRefs {
             params: &params,
@@ -67,6 +71,34 @@ impl Renderer for CpuRenderer {
 
     fn samples(&self) -> u32 {
         self.samples
+    }
+
+    fn first_sample(&self) -> u32 {
+        self.first_sample
+    }
+
+    fn read_accumulation(&mut self) -> Result<Accumulation> {
+        Ok(Accumulation {
+            width: self.scene.params.width,
+            height: self.scene.params.height,
+            count: self.samples,
+            mean: self.stats.iter().map(|s| s.mean.into()).collect(),
+            m2: self.stats.iter().map(|s| s.m2.into()).collect(),
+        })
+    }
+
+    fn load_accumulation(&mut self, first_sample: u32, state: Option<&Accumulation>) -> Result<()> {
+        self.reset()?;
+        if let Some(state) = state {
+            check_size(&self.scene.params, state)?;
+            for (stats, (mean, m2)) in self.stats.iter_mut().zip(state.mean.iter().zip(&state.m2)) {
+                stats.mean = (*mean).into();
+                stats.m2 = (*m2).into();
+            }
+            self.samples = state.count;
+        }
+        self.first_sample = first_sample;
+        Ok(())
     }
 
     fn read_mean(&mut self) -> Result<Image> {
@@ -107,6 +139,10 @@ impl Renderer for CpuRenderer {
 
     fn segments_traced(&self) -> Option<u64> {
         Some(self.segments)
+    }
+
+    fn nonfinite_samples(&self) -> u64 {
+        self.stats.iter().map(|s| s.nonfinite as u64).sum()
     }
 
     fn device_name(&self) -> String {

@@ -1,13 +1,15 @@
 //! Path tracing (WGSL side: `shaders/trace.wgsl`).
 
+use super::accumulate::{accumulator_start, add_sample, merge_block};
 use super::aov::{
     aov_mean_add, aov_merge, aov_record_hit, aov_record_miss, aov_start, aovs_on, AovMean, PathAov,
 };
 use super::camera::camera_ray;
-use super::intersect::{first_hit_is, intersect_scene, offset_ray_origin, NO_HIT};
+use super::intersect::{first_hit_is, intersect_scene, NO_HIT};
 use super::lights::{light_pdf, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
+use super::surface::offset_ray_origin;
 use super::Ray;
 use crate::shader_types::{Emitter, Material, Params, Quad, Sphere};
 use glam::Vec3;
@@ -118,7 +120,7 @@ pub fn path_step(
     }
     let p = hit.position;
     let wo = -ray.dir;
-    let origin = offset_ray_origin(p, hit.normal);
+    let origin = offset_ray_origin(p, hit.error, hit.normal);
     if light_sampling && !is_delta(m) {
         // Next-event estimation: light arriving after one more scattering event.
         let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
@@ -177,7 +179,7 @@ pub fn path_step(
         -hit.normal
     };
     path.ray = Ray {
-        origin: offset_ray_origin(p, side),
+        origin: offset_ray_origin(p, hit.error, side),
         dir: s.dir,
     };
     path.ray_start = p;
@@ -204,41 +206,38 @@ pub fn trace_path(
 pub struct PixelStats {
     pub mean: Vec3,
     pub m2: Vec3,
+    /// Samples dropped as NaN, infinite or too large (`shaders/accumulate.wgsl`).
+    pub nonfinite: u32,
     /// Mean albedo, normal and depth, when `params.aovs` asks for them.
     pub aov: AovMean,
 }
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
-/// `params.sample_start`, merged into `stats`, which holds the `params.sample_start` samples
-/// before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
+/// `params.sample_start`, merged into `stats`, which holds the `params.accumulated_samples`
+/// samples before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
 /// for SIMD efficiency; each sample's result is the same, and they finish in the same order.)
 pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
     let params = scene.params;
     let pixel = py * params.width + px;
-    // Welford over this batch's samples...
-    let mut mean = Vec3::ZERO;
-    let mut m2 = Vec3::ZERO;
+    let mut acc = accumulator_start(params.accumulated_samples, stats.mean, stats.m2);
     let mut aov_mean = AovMean::default();
     let mut segments = 0;
     for i in 0..params.sample_count {
-        let path = trace_path(scene, pixel, px, py, params.sample_start + i, &mut segments);
-        let x = path.radiance;
-        let delta = x - mean;
-        mean += delta / (i + 1) as f32;
-        m2 += delta * (x - mean);
+        let sample = params.sample_start + i;
+        let path = trace_path(scene, pixel, px, py, sample, &mut segments);
+        add_sample(&mut acc, path.radiance, sample);
         if aovs_on(params) {
             aov_mean_add(&mut aov_mean, &path.aov, i);
         }
     }
-    // ...then merged into the totals (Chan, Golub and LeVeque's pairwise update).
-    let n_old = params.sample_start as f32;
-    let n_new = params.sample_count as f32;
-    let n = n_old + n_new;
-    let delta = mean - stats.mean;
-    stats.mean += delta * (n_new / n);
-    stats.m2 = stats.m2 + m2 + delta * delta * (n_old * n_new / n);
+    // A batch ended inside a block (the render loop avoids this) keeps the statistics right.
+    merge_block(&mut acc);
+    stats.mean = acc.mean;
+    stats.m2 = acc.m2;
+    stats.nonfinite += acc.nonfinite;
     if aovs_on(params) {
-        aov_merge(&mut stats.aov, &aov_mean, n_old, n_new);
+        let n_old = params.accumulated_samples as f32;
+        aov_merge(&mut stats.aov, &aov_mean, n_old, params.sample_count as f32);
     }
     segments
 }

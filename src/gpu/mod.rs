@@ -2,7 +2,10 @@
 
 pub mod binding;
 pub mod context;
+pub mod limits;
+pub mod loop_budget;
 pub mod renderer;
+pub mod tiles;
 
 pub use context::{GpuContext, GpuUnavailable};
 pub use renderer::GpuRenderer;

@@ -2,9 +2,15 @@
 
 use super::binding::{compute_bind_group, compute_pipeline};
 use super::context::GpuContext;
+use super::limits::{check_buffers, BufferBinding, BufferNeed};
+use super::loop_budget::{
+    device_loop_limit, loop_iterations_per_sample, max_samples_per_dispatch, LAVAPIPE_LOOP_LIMIT,
+};
+use super::tiles::{next_tile, TilePlanner};
+use crate::accumulation::Accumulation;
 use crate::aov::Aovs;
 use crate::output::Image;
-use crate::render::{variance_of_mean, Renderer};
+use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use crate::shader::{
     render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding, RENDER_ENTRY_POINT,
@@ -31,11 +37,25 @@ pub struct GpuRenderer<'a> {
     aov_buffers: [wgpu::Buffer; 2],
     readback_buffer: wgpu::Buffer,
     samples: u32,
+    first_sample: u32,
     /// The kernel's segment counter (one u32).
     counter_buffer: wgpu::Buffer,
     /// Benchmark instrumentation, off unless asked for: it reads back after every batch.
     instruments: Option<Instruments>,
+    /// The origin of the tile a dispatch covers (`shaders/tiles.wgsl`).
+    tile_buffer: wgpu::Buffer,
+    tiles: TilePlanner,
+    /// The kernel's count of dropped samples (one u32), read and cleared after every batch.
+    nonfinite_buffer: wgpu::Buffer,
+    nonfinite_readback: wgpu::Buffer,
+    nonfinite: u64,
+    /// The device's loop limit (lavapipe: src/gpu/loop_budget.rs).
+    loop_limit: Option<u64>,
 }
+
+/// Wanted duration of one GPU submission: a batch longer than this is split into tiles.
+/// Desktop drivers kill submissions after about 2 s; lavapipe has no watchdog.
+pub const SUBMISSION_TARGET: std::time::Duration = std::time::Duration::from_millis(250);
 
 /// Timestamp queries and the segment count, read after each batch.
 struct Instruments {
@@ -55,6 +75,11 @@ pub fn storage_buffer<T: Pod + Default>(
     items: &[T],
 ) -> wgpu::Buffer {
     scene_buffer(ctx, label, items, wgpu::BufferUsages::STORAGE)
+}
+
+/// Bytes of the buffer [`scene_buffer`] makes for `items` (at least one element).
+fn array_bytes<T>(items: &[T]) -> u64 {
+    items.len().max(1) as u64 * size_of::<T>() as u64
 }
 
 /// A buffer of the scene's objects for a storage or uniform binding, holding at least one
@@ -121,21 +146,11 @@ impl<'a> GpuRenderer<'a> {
         let params = scene.params;
         let pixel_count = params.width as u64 * params.height as u64;
         let accum_size = pixel_count * 16;
-        let max_binding = device.limits().max_storage_buffer_binding_size;
-        if accum_size > max_binding {
-            return Err(anyhow!(
-                "a {}×{} image needs a {} MiB accumulation buffer; this device binds at most {} MiB",
-                params.width,
-                params.height,
-                accum_size >> 20,
-                max_binding >> 20
-            ));
-        }
-        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
+        let aov_size = if variant.features.aovs {
+            accum_size
+        } else {
+            16
+        };
         let (usage, scene_type) = match variant.binding {
             SceneBinding::Storage => (
                 wgpu::BufferUsages::STORAGE,
@@ -146,6 +161,25 @@ impl<'a> GpuRenderer<'a> {
                 wgpu::BufferBindingType::Uniform,
             ),
         };
+        // Before any upload: a scene the device cannot hold is bad input, not a wgpu error.
+        check_buffers(
+            &device.limits(),
+            &[
+                BufferNeed::new("spheres", array_bytes(&scene.spheres), scene_type),
+                BufferNeed::new("quads", array_bytes(&scene.quads), scene_type),
+                BufferNeed::new("materials", array_bytes(&scene.materials), scene_type),
+                BufferNeed::new("emitters", array_bytes(&scene.emitters), scene_type),
+                BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
+                BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
+                BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
+                BufferNeed::new("aov_normal", aov_size, BufferBinding::Storage),
+            ],
+        )?;
+        let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
         let spheres = scene_buffer(ctx, "spheres", &scene.spheres, usage);
         let quads = scene_buffer(ctx, "quads", &scene.quads, usage);
         let materials = scene_buffer(ctx, "materials", &scene.materials, usage);
@@ -168,13 +202,28 @@ impl<'a> GpuRenderer<'a> {
                 | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let tile_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("tile_origin"),
+            size: 16,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let nonfinite_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("nonfinite_samples"),
+            size: 8,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let nonfinite_readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("nonfinite readback"),
+            size: 8,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let mean_buffer = accumulator("accum_mean");
         let m2_buffer = accumulator("accum_m2");
-        let aov_size = if variant.features.aovs {
-            accum_size
-        } else {
-            16
-        };
         let aov_buffers = ["aov_albedo_depth", "aov_normal"].map(|label| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -206,6 +255,8 @@ impl<'a> GpuRenderer<'a> {
                 (7, read_write, &counter_buffer),
                 (8, read_write, &aov_buffers[0]),
                 (9, read_write, &aov_buffers[1]),
+                (16, read_write, &nonfinite_buffer),
+                (17, wgpu::BufferBindingType::Uniform, &tile_buffer),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -220,7 +271,7 @@ impl<'a> GpuRenderer<'a> {
             RENDER_ENTRY_POINT,
         );
         ctx.wait_idle()?;
-        Ok(GpuRenderer {
+        let renderer = GpuRenderer {
             ctx,
             variant,
             pipeline,
@@ -232,9 +283,40 @@ impl<'a> GpuRenderer<'a> {
             aov_buffers,
             readback_buffer,
             samples: 0,
+            first_sample: 0,
             counter_buffer,
             instruments: None,
-        })
+            tile_buffer,
+            tiles: TilePlanner::new(SUBMISSION_TARGET),
+            nonfinite_buffer,
+            nonfinite_readback,
+            nonfinite: 0,
+            loop_limit: device_loop_limit(&ctx.adapter_info),
+        };
+        renderer.warm_up()?;
+        Ok(renderer)
+    }
+
+    /// Runs the kernel once, on one workgroup and with no samples (it returns at once, leaving
+    /// the image untouched), so the driver finishes compiling it now: lavapipe compiles at the
+    /// first dispatch (about 1 s with a cold Mesa cache), which would otherwise count as
+    /// render time.
+    fn warm_up(&self) -> Result<()> {
+        let params = Params {
+            sample_count: 0,
+            ..self.params
+        };
+        let queue = &self.ctx.queue;
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        queue.submit([encoder.finish()]);
+        self.ctx.wait_idle()
     }
 
     /// Turns on benchmark instrumentation: after every batch, the renderer reads back the
@@ -274,10 +356,11 @@ impl<'a> GpuRenderer<'a> {
         });
     }
 
-    /// Reads the counter and timestamps of the batch just submitted, and clears the counter.
-    fn read_instruments(&mut self) -> Result<()> {
+    /// Reads the counter and timestamps of the submission just made, and clears the counter;
+    /// returns the kernel's device time (zero where it is not measured).
+    fn read_instruments(&mut self) -> Result<std::time::Duration> {
         let Some(instruments) = &mut self.instruments else {
-            return Ok(());
+            return Ok(std::time::Duration::ZERO);
         };
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         encoder.copy_buffer_to_buffer(&self.counter_buffer, 0, &instruments.readback, 0, 8);
@@ -294,9 +377,16 @@ impl<'a> GpuRenderer<'a> {
         instruments.segments += segments as u64;
         if instruments.timestamps.is_some() && t1 > t0 {
             let ns = (t1 - t0) as f64 * self.ctx.queue.get_timestamp_period() as f64;
-            instruments.last_kernel_time = Some(std::time::Duration::from_nanos(ns as u64));
+            return Ok(std::time::Duration::from_nanos(ns as u64));
         }
-        Ok(())
+        Ok(std::time::Duration::ZERO)
+    }
+
+    /// Sets the wanted duration of one GPU submission (default [`SUBMISSION_TARGET`]); batches
+    /// that would take longer are split into tiles of pixels. Zero gives the smallest tiles
+    /// (one workgroup each), which tests use to check that tiling never changes the image.
+    pub fn set_submission_target(&mut self, target: std::time::Duration) {
+        self.tiles = TilePlanner::new(target);
     }
 
     /// The per-pixel mean radiance (vec4 per pixel, xyz used), for display passes that read it
@@ -354,6 +444,90 @@ impl<'a> GpuRenderer<'a> {
         })
     }
 
+    /// One submission: the batch in `self.params` over the pixels of `tile`, waited for.
+    fn submit_tile(&mut self, tile: super::tiles::Tile) -> Result<()> {
+        let origin = [tile.x, tile.y, 0, 0];
+        self.ctx
+            .queue
+            .write_buffer(&self.tile_buffer, 0, bytemuck::bytes_of(&origin));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        let timestamps = self
+            .instruments
+            .as_ref()
+            .and_then(|i| i.timestamps.as_ref());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("render"),
+                timestamp_writes: timestamps.map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                    query_set: set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.dispatch_workgroups(
+                tile.width.div_ceil(WORKGROUP_SIZE.0),
+                tile.height.div_ceil(WORKGROUP_SIZE.1),
+                1,
+            );
+        }
+        if let Some((set, resolve)) = timestamps {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+        self.ctx.wait_idle()
+    }
+
+    /// Reads and clears the kernel's counters: dropped samples and invocations cut short.
+    fn take_counters(&self) -> Result<[u32; 2]> {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&self.nonfinite_buffer, 0, &self.nonfinite_readback, 0, 8);
+        encoder.clear_buffer(&self.nonfinite_buffer, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.ctx.read_mapped(&self.nonfinite_readback, |bytes| {
+            let words = bytemuck::cast_slice::<u8, u32>(bytes);
+            [words[0], words[1]]
+        })
+    }
+
+    /// Samples `first..first + count` for every pixel, in tiles.
+    fn dispatch_samples(&mut self, first: u32, count: u32) -> Result<()> {
+        self.params.sample_start = first;
+        self.params.accumulated_samples = first - self.first_sample;
+        self.params.sample_count = count;
+        self.ctx
+            .queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        // Tiles sized so each submission lasts about SUBMISSION_TARGET (src/gpu/tiles.rs).
+        let (width, height) = (self.params.width, self.params.height);
+        let (mut x, mut y) = (0, 0);
+        let mut last_pixels = None;
+        let mut kernel_time = std::time::Duration::ZERO;
+        while y < height {
+            let budget = self.tiles.pixel_budget(count, last_pixels);
+            let tile = next_tile(width, height, x, y, budget);
+            let started = std::time::Instant::now();
+            self.submit_tile(tile)?;
+            let took = started.elapsed();
+            let pixels = tile.width as u64 * tile.height as u64;
+            self.tiles.record(pixels, count, took);
+            last_pixels = Some(pixels);
+            kernel_time += self.read_instruments()?;
+            x += tile.width;
+            if x >= width {
+                x = 0;
+                y += tile.height;
+            }
+        }
+        if let Some(instruments) = &mut self.instruments {
+            if instruments.timestamps.is_some() {
+                instruments.last_kernel_time = Some(kernel_time);
+            }
+        }
+        Ok(())
+    }
+
     /// The first three floats of each vec4 of `buffer`.
     fn read_vec3s(&self, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 3]>> {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
@@ -378,44 +552,76 @@ impl<'a> GpuRenderer<'a> {
 
 impl Renderer for GpuRenderer<'_> {
     fn add_samples(&mut self, count: u32) -> Result<()> {
-        self.params.sample_start = self.samples;
-        self.params.sample_count = count;
-        self.ctx
-            .queue
-            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        let timestamps = self
-            .instruments
-            .as_ref()
-            .and_then(|i| i.timestamps.as_ref());
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("render"),
-                timestamp_writes: timestamps.map(|(set, _)| wgpu::ComputePassTimestampWrites {
-                    query_set: set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &self.bind_group, &[]);
-            pass.dispatch_workgroups(
-                self.params.width.div_ceil(WORKGROUP_SIZE.0),
-                self.params.height.div_ceil(WORKGROUP_SIZE.1),
-                1,
-            );
+        // Dispatches of at most this many samples stay within lavapipe's loop limit. They end
+        // at multiples of a power of two of samples, fixed by the scene and the device, so
+        // where the kernel merges (shaders/accumulate.wgsl) never depends on the batching;
+        // from 64 on those multiples are block ends anyway.
+        let per_dispatch = max_samples_per_dispatch(&self.params, self.loop_limit);
+        let step = 1u32 << (31 - per_dispatch.leading_zeros());
+        // Global sample indices: a partial render's dispatches end where a single render's do.
+        let end = self.first_sample + self.samples + count;
+        let mut first = self.first_sample + self.samples;
+        while first < end {
+            let next = (first / step + 1).saturating_mul(step).min(end);
+            self.dispatch_samples(first, next - first)?;
+            first = next;
         }
-        if let Some((set, resolve)) = timestamps {
-            encoder.resolve_query_set(set, 0..2, resolve, 0);
+        self.samples = end - self.first_sample;
+        let [nonfinite, cut_short] = self.take_counters()?;
+        self.nonfinite += nonfinite as u64;
+        if cut_short > 0 {
+            return Err(anyhow!(
+                "the GPU driver ended the kernel early in {cut_short} pixel groups: lavapipe ends \
+                 a shader's loops after {LAVAPIPE_LOOP_LIMIT} iterations in all, and one sample of \
+                 this scene ({} spheres and quads, {} bounces) can need {} (render with --cpu)",
+                self.params.sphere_count + self.params.quad_count,
+                self.params.max_bounces,
+                loop_iterations_per_sample(&self.params)
+            ));
         }
-        self.ctx.queue.submit([encoder.finish()]);
-        self.ctx.wait_idle()?;
-        self.samples += count;
-        self.read_instruments()
+        Ok(())
     }
 
     fn samples(&self) -> u32 {
         self.samples
+    }
+
+    fn first_sample(&self) -> u32 {
+        self.first_sample
+    }
+
+    fn read_accumulation(&mut self) -> Result<Accumulation> {
+        Ok(Accumulation {
+            width: self.params.width,
+            height: self.params.height,
+            count: self.samples,
+            mean: self.read_vec3s(&self.mean_buffer)?,
+            m2: self.read_vec3s(&self.m2_buffer)?,
+        })
+    }
+
+    fn load_accumulation(&mut self, first_sample: u32, state: Option<&Accumulation>) -> Result<()> {
+        self.reset()?;
+        if let Some(state) = state {
+            check_size(&self.params, state)?;
+            let vec4s = |v: &[[f32; 3]]| -> Vec<[f32; 4]> {
+                v.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect()
+            };
+            let queue = &self.ctx.queue;
+            queue.write_buffer(
+                &self.mean_buffer,
+                0,
+                bytemuck::cast_slice(&vec4s(&state.mean)),
+            );
+            queue.write_buffer(&self.m2_buffer, 0, bytemuck::cast_slice(&vec4s(&state.m2)));
+            self.samples = state.count;
+        }
+        self.first_sample = first_sample;
+        self.ctx.wait_idle()
+    }
+
+    fn nonfinite_samples(&self) -> u64 {
+        self.nonfinite
     }
 
     fn read_mean(&mut self) -> Result<Image> {
@@ -448,8 +654,10 @@ impl Renderer for GpuRenderer<'_> {
         encoder.clear_buffer(&self.mean_buffer, 0, None);
         encoder.clear_buffer(&self.m2_buffer, 0, None);
         encoder.clear_buffer(&self.counter_buffer, 0, None);
+        encoder.clear_buffer(&self.nonfinite_buffer, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.samples = 0;
+        self.nonfinite = 0;
         if let Some(instruments) = &mut self.instruments {
             instruments.segments = 0;
         }

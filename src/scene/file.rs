@@ -44,6 +44,11 @@ impl<'de> Deserialize<'de> for Real {
 
 pub(super) type S<T> = Spanned<T>;
 
+/// A 3-vector as written, any TOML value: [`super::validate`] checks that it is exactly three
+/// numbers, where the field's name is known for the message. (serde's `[T; 3]` stops reading
+/// after three elements, so `[1, 2, 3, "x"]` would pass with the rest unparsed.)
+pub(super) type Triple = toml::Value;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SceneToml {
@@ -60,9 +65,9 @@ pub(super) struct SceneToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct CameraToml {
-    pub(super) eye: S<[Real; 3]>,
-    pub(super) target: S<[Real; 3]>,
-    pub(super) up: S<[Real; 3]>,
+    pub(super) eye: S<Triple>,
+    pub(super) target: S<Triple>,
+    pub(super) up: S<Triple>,
     pub(super) vfov: S<Real>,
     pub(super) aperture: Option<S<Real>>,
     pub(super) focus_distance: Option<S<Real>>,
@@ -75,7 +80,7 @@ pub(super) struct RenderToml {
     pub(super) height: S<i64>,
     pub(super) spp: S<i64>,
     pub(super) max_bounces: S<i64>,
-    pub(super) background: Option<S<[Real; 3]>>,
+    pub(super) background: Option<S<Triple>>,
     pub(super) seed: Option<S<i64>>,
     pub(super) light_sampling: Option<bool>,
     pub(super) russian_roulette: Option<bool>,
@@ -86,8 +91,8 @@ pub(super) struct RenderToml {
 pub(super) struct MaterialToml {
     #[serde(rename = "type")]
     pub(super) kind: S<String>,
-    pub(super) color: Option<S<[Real; 3]>>,
-    pub(super) emission: Option<S<[Real; 3]>>,
+    pub(super) color: Option<S<Triple>>,
+    pub(super) emission: Option<S<Triple>>,
     pub(super) strength: Option<S<Real>>,
     pub(super) roughness: Option<S<Real>>,
     pub(super) ior: Option<S<Real>>,
@@ -96,7 +101,7 @@ pub(super) struct MaterialToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct SphereToml {
-    pub(super) center: S<[Real; 3]>,
+    pub(super) center: S<Triple>,
     pub(super) radius: S<Real>,
     pub(super) material: S<String>,
 }
@@ -104,8 +109,8 @@ pub(super) struct SphereToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct QuadToml {
-    pub(super) corner: S<[Real; 3]>,
-    pub(super) u: S<[Real; 3]>,
-    pub(super) v: S<[Real; 3]>,
+    pub(super) corner: S<Triple>,
+    pub(super) u: S<Triple>,
+    pub(super) v: S<Triple>,
     pub(super) material: S<String>,
 }

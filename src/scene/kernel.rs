@@ -56,8 +56,10 @@ impl Scene {
             } else {
                 ROULETTE_OFF
             },
-            radiance_clamp: 0.0,
+            accumulated_samples: 0,
             aovs: 0,
+            radiance_clamp: 0.0,
+            _pad: [0; 3],
         };
         let spheres = self
             .spheres

@@ -9,10 +9,12 @@
 
 mod file;
 mod kernel;
+pub mod limits;
 mod validate;
 
 pub use kernel::KernelScene;
 
+use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
 use glam::Vec3;
 use std::ops::Range;
@@ -92,12 +94,14 @@ pub struct CameraBasis {
 
 impl Camera {
     pub fn basis(&self) -> CameraBasis {
-        let w = (self.eye - self.target).normalize();
-        let right = self.up.cross(w).normalize();
+        // In f64: the squares of a short `up` (1e-25) or of a cross product of nearly
+        // parallel vectors underflow in f32, and normalising them would give NaN.
+        let w = (self.eye.as_dvec3() - self.target.as_dvec3()).normalize();
+        let right = self.up.as_dvec3().cross(w).normalize();
         CameraBasis {
-            w,
-            right,
-            image_up: w.cross(right),
+            w: w.as_vec3(),
+            right: right.as_vec3(),
+            image_up: w.cross(right).as_vec3(),
         }
     }
 }
@@ -167,11 +171,13 @@ pub struct RenderOverrides {
 impl Scene {
     /// Reads and validates a scene file.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let bytes = std::fs::read(path).map_err(|e| SceneError {
-            path: path.to_owned(),
-            position: None,
-            field: None,
-            message: format!("cannot read the scene file: {e}"),
+        let bytes = read_regular_file(path, SCENE_FILE_LIMIT, "scene file").map_err(|message| {
+            SceneError {
+                path: path.to_owned(),
+                position: None,
+                field: None,
+                message,
+            }
         })?;
         let text = String::from_utf8(bytes).map_err(|e| SceneError {
             path: path.to_owned(),

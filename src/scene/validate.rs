@@ -1,12 +1,13 @@
 //! From the file as written to a validated [`Scene`]: every range, reference and degenerate
 //! case checked, each failure tied to its field and its place in the file.
 
-use super::file::{Real, SceneToml, S};
+use super::file::{Real, SceneToml, Triple, S};
+use super::limits::{MAX_COORDINATE, MAX_IOR, MAX_RADIANCE, MIN_IOR, MIN_LENGTH, MIN_SINE};
 use super::{
     check_image_size, check_range, Camera, Material, MaterialKind, Quad, RenderSettings, Scene,
     Sphere, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
 };
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -40,30 +41,122 @@ fn real(x: &S<Real>, field: &str) -> Result<f32, FieldError> {
     Ok(v as f32)
 }
 
-fn vec3(x: &S<[Real; 3]>, field: &str) -> Result<Vec3, FieldError> {
+/// A 3-vector: exactly three finite numbers (integers accepted), each fitting an f32.
+fn vec3(x: &S<Triple>, field: &str) -> Result<Vec3, FieldError> {
+    let toml::Value::Array(items) = x.get_ref() else {
+        return fail(
+            x.span(),
+            field,
+            format!(
+                "must be an array of three numbers [x, y, z], got a {}",
+                x.get_ref().type_str()
+            ),
+        );
+    };
+    if items.len() != 3 {
+        return fail(
+            x.span(),
+            field,
+            format!(
+                "must be exactly three numbers [x, y, z], got {} elements",
+                items.len()
+            ),
+        );
+    }
     let mut out = [0.0f32; 3];
-    for (o, r) in out.iter_mut().zip(x.get_ref()) {
-        if !r.0.is_finite() || r.0.abs() > f32::MAX as f64 {
+    for (i, (o, item)) in out.iter_mut().zip(items).enumerate() {
+        let v = match item {
+            toml::Value::Float(v) => *v,
+            toml::Value::Integer(v) => *v as f64,
+            other => {
+                return fail(
+                    x.span(),
+                    field,
+                    format!(
+                        "element {i} must be a number, got a {} ({other})",
+                        other.type_str()
+                    ),
+                )
+            }
+        };
+        if !v.is_finite() || v.abs() > f32::MAX as f64 {
             return fail(
                 x.span(),
                 field,
-                format!(
-                    "every component must be a finite 32-bit number, got {}",
-                    r.0
-                ),
+                format!("every component must be a finite 32-bit number, got {v}"),
             );
         }
-        *o = r.0 as f32;
+        *o = v as f32;
     }
     Ok(Vec3::from(out))
 }
 
-fn non_negative(x: &S<[Real; 3]>, field: &str) -> Result<Vec3, FieldError> {
+/// A point or an edge vector: a 3-vector within the supported coordinate range.
+fn coordinates(x: &S<Triple>, field: &str) -> Result<Vec3, FieldError> {
+    let v = vec3(x, field)?;
+    if v.abs().max_element() > MAX_COORDINATE {
+        return fail(
+            x.span(),
+            field,
+            format!(
+                "every component must be within ±{MAX_COORDINATE:e} (the numeric range glint \
+                 supports), got {v}"
+            ),
+        );
+    }
+    Ok(v)
+}
+
+/// A length with a lower bound of `min` (0 or [`MIN_LENGTH`]) and the coordinate range's
+/// upper bound.
+fn length_in_range(x: &S<Real>, field: &str, value: f32, min: f32) -> Result<f32, FieldError> {
+    if !(min..=MAX_COORDINATE).contains(&value) {
+        return fail(
+            x.span(),
+            field,
+            format!(
+                "must be in [{}, {MAX_COORDINATE:e}] (the numeric range glint supports), got \
+                 {value:e}",
+                if min == 0.0 {
+                    "0".into()
+                } else {
+                    format!("{min:e}")
+                }
+            ),
+        );
+    }
+    Ok(value)
+}
+
+fn non_negative(x: &S<Triple>, field: &str) -> Result<Vec3, FieldError> {
     let v = vec3(x, field)?;
     if v.min_element() < 0.0 {
         return fail(x.span(), field, format!("components must be ≥ 0, got {v}"));
     }
     Ok(v)
+}
+
+/// A radiance (emitted or background): ≥ 0 and at most [`MAX_RADIANCE`] per channel.
+fn radiance_in_range(span: Range<usize>, field: &str, value: DVec3) -> Result<(), FieldError> {
+    if value.max_element() > MAX_RADIANCE {
+        return fail(
+            span,
+            field,
+            format!(
+                "a radiance of {:e} is too bright: at most {MAX_RADIANCE:e} per channel (the \
+                 numeric range glint supports)",
+                value.max_element()
+            ),
+        );
+    }
+    Ok(())
+}
+
+/// Sine of the angle between two non-zero vectors, in f64 so that short or long ones neither
+/// underflow nor overflow.
+fn sine_between(a: Vec3, b: Vec3) -> f64 {
+    let (a, b) = (a.as_dvec3().normalize(), b.as_dvec3().normalize());
+    a.cross(b).length()
 }
 
 fn int_in(x: &S<i64>, field: &str, min: i64, max: i64) -> Result<u32, FieldError> {
@@ -95,8 +188,8 @@ impl SceneToml {
         let render_span = render.span();
         let render = render.into_inner();
 
-        let eye = vec3(&camera.eye, "camera.eye")?;
-        let target = vec3(&camera.target, "camera.target")?;
+        let eye = coordinates(&camera.eye, "camera.eye")?;
+        let target = coordinates(&camera.target, "camera.target")?;
         let up = vec3(&camera.up, "camera.up")?;
         let vfov = real(&camera.vfov, "camera.vfov")?;
         if !(vfov > 0.0 && vfov < 180.0) {
@@ -107,14 +200,14 @@ impl SceneToml {
             );
         }
         let view = target - eye;
-        if view.length() == 0.0 || !view.length().is_finite() {
+        if view.as_dvec3().length() == 0.0 {
             return fail(
                 camera.target.span(),
                 "camera.target",
                 "must differ from camera.eye (the view direction is target − eye)",
             );
         }
-        if up.cross(view).length() <= 1e-6 * up.length() * view.length() {
+        if up == Vec3::ZERO || sine_between(up, view) <= MIN_SINE {
             return fail(
                 camera.up.span(),
                 "camera.up",
@@ -134,7 +227,7 @@ impl SceneToml {
                         format!("the lens diameter must be ≥ 0, got {v}"),
                     );
                 }
-                v
+                length_in_range(a, "camera.aperture", v, 0.0)?
             }
             None => 0.0,
         };
@@ -148,9 +241,9 @@ impl SceneToml {
                         format!("must be > 0, got {v}"),
                     );
                 }
-                v
+                length_in_range(f, "camera.focus_distance", v, MIN_LENGTH)?
             }
-            None => view.length(),
+            None => view.as_dvec3().length() as f32,
         };
 
         let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
@@ -172,7 +265,11 @@ impl SceneToml {
             MAX_BOUNCES_LIMIT as i64,
         )?;
         let background = match &render.background {
-            Some(b) => non_negative(b, "render.background")?,
+            Some(b) => {
+                let v = non_negative(b, "render.background")?;
+                radiance_in_range(b.span(), "render.background", v.as_dvec3())?;
+                v
+            }
             None => Vec3::ZERO,
         };
         let seed = match &render.seed {
@@ -212,11 +309,14 @@ impl SceneToml {
                 }
                 "dielectric" => {
                     let ior = positive(&m.ior, "ior", "dielectric")?;
-                    if ior <= 0.0 {
+                    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
                         return fail(
                             m.ior.as_ref().unwrap().span(),
                             field("ior"),
-                            format!("the index of refraction must be > 0, got {ior}"),
+                            format!(
+                                "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
+                                 numeric range glint supports), got {ior}"
+                            ),
                         );
                     }
                     MaterialKind::Dielectric { ior }
@@ -288,6 +388,16 @@ impl SceneToml {
                 }
                 None => 1.0,
             };
+            // Each factor may be in range and the product not (1e30 × 1e30): check the product,
+            // in f64, where it is exact enough and cannot overflow.
+            if let Some(e) = &m.emission {
+                let span = m.strength.as_ref().map_or(e.span(), |s| s.span());
+                radiance_in_range(
+                    span,
+                    &field("emission × strength"),
+                    emission.as_dvec3() * strength as f64,
+                )?;
+            }
             index_of.insert(name.clone(), materials.len() as u32);
             materials.push(Material {
                 name: name.clone(),
@@ -319,7 +429,7 @@ impl SceneToml {
         for (i, s) in self.spheres.iter().enumerate() {
             let s = s.get_ref();
             let field = |f: &str| format!("spheres[{i}].{f}");
-            let center = vec3(&s.center, &field("center"))?;
+            let center = coordinates(&s.center, &field("center"))?;
             let radius = real(&s.radius, &field("radius"))?;
             if radius <= 0.0 {
                 return fail(
@@ -328,6 +438,7 @@ impl SceneToml {
                     format!("must be > 0, got {radius}"),
                 );
             }
+            length_in_range(&s.radius, &field("radius"), radius, MIN_LENGTH)?;
             let material = material_ref(&s.material, field("material"))?;
             spheres.push(Sphere {
                 center,
@@ -339,16 +450,29 @@ impl SceneToml {
         for (i, q) in self.quads.iter().enumerate() {
             let q = q.get_ref();
             let field = |f: &str| format!("quads[{i}].{f}");
-            let corner = vec3(&q.corner, &field("corner"))?;
-            let u = vec3(&q.u, &field("u"))?;
-            let v = vec3(&q.v, &field("v"))?;
-            let area = u.cross(v).length();
-            if !area.is_finite() || area <= 1e-6 * u.length() * v.length() {
+            let corner = coordinates(&q.corner, &field("corner"))?;
+            let u = coordinates(&q.u, &field("u"))?;
+            let v = coordinates(&q.v, &field("v"))?;
+            // Scale-relative: the angle between the edges, not the area against a fixed bound.
+            if u == Vec3::ZERO || v == Vec3::ZERO || sine_between(u, v) <= MIN_SINE {
                 return fail(
                     q.v.span(),
                     field("v"),
                     format!("degenerate quad: edges u = {u} and v = {v} are parallel or zero"),
                 );
+            }
+            for (edge, name, span) in [(u, "u", q.u.span()), (v, "v", q.v.span())] {
+                let length = edge.as_dvec3().length();
+                if length < MIN_LENGTH as f64 {
+                    return fail(
+                        span,
+                        field(name),
+                        format!(
+                            "the edge is {length:e} long, shorter than {MIN_LENGTH:e} (the \
+                             numeric range glint supports)"
+                        ),
+                    );
+                }
             }
             let material = material_ref(&q.material, field("material"))?;
             quads.push(Quad {

@@ -5,12 +5,14 @@ use super::action::{Action, Script};
 use super::camera_control;
 use super::display::DisplayPass;
 use super::input::InputState;
-use super::watch::FileWatch;
+use super::watch::{BackgroundLoad, FileWatch};
 use super::{ViewOptions, FRAME_TARGET};
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::{Image, ImageFormat};
 use crate::render::{BatchSizer, Renderer};
-use crate::scene::{Camera, KernelScene, RenderOverrides, Scene, MAX_IMAGE_PIXELS, MAX_SPP};
+use crate::scene::{
+    Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS, MAX_SPP,
+};
 use anyhow::{anyhow, Context, Result};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -35,6 +37,7 @@ pub fn run(event_loop: EventLoop<()>, scene: Scene, mut options: ViewOptions) ->
     let script = std::mem::take(&mut options.script);
     let mut app = App {
         watch: FileWatch::new(&options.scene),
+        loader: BackgroundLoad::new(&options.scene),
         sizer: BatchSizer::new(FRAME_TARGET),
         file_camera: scene.camera.clone(),
         camera: scene.camera.clone(),
@@ -86,6 +89,8 @@ struct App {
     sizer: BatchSizer,
     input: InputState,
     watch: FileWatch,
+    /// Edits noticed by `watch` are read here, off the event loop.
+    loader: BackgroundLoad,
     gpu: Option<Gpu>,
     pending_size: Option<PhysicalSize<u32>>,
     frame: u64,
@@ -153,7 +158,7 @@ fn pick_format(formats: &[wgpu::TextureFormat]) -> Option<wgpu::TextureFormat> {
 impl App {
     fn log(&self, line: serde_json::Value) {
         if self.options.log_frames {
-            println!("{line}");
+            crate::outln!("{line}");
         }
     }
 
@@ -217,7 +222,7 @@ impl App {
         let renderer = GpuRenderer::new(ctx, &self.kernel_scene())?;
         let mut display = DisplayPass::new(&ctx.device, format);
         display.bind(&ctx.device, renderer.mean_buffer());
-        eprintln!(
+        crate::errln!(
             "glint view: {} on {} ({:?}, {:?}); drag to orbit, right-drag to pan, wheel to dolly, WASDQE to fly",
             self.options.scene.display(),
             ctx.device_name(),
@@ -316,11 +321,18 @@ impl App {
         Ok(())
     }
 
-    /// Re-reads the scene file; a broken file is reported and the last good scene stays.
+    /// Re-reads the scene file now (scripted reloads; edits go through [`BackgroundLoad`]).
     fn reload(&mut self) -> Result<()> {
+        let loaded = Scene::load(&self.options.scene);
+        self.apply_loaded(loaded)
+    }
+
+    /// Adopts a freshly read scene file; a broken file is reported and the last good scene
+    /// stays.
+    fn apply_loaded(&mut self, loaded: Result<Scene, SceneError>) -> Result<()> {
         let (width, height) = self.image_size();
         let path = self.options.scene.clone();
-        let loaded = match Scene::load(&path) {
+        let loaded = match loaded {
             Ok(scene) => scene
                 .with_overrides(&RenderOverrides {
                     width: Some(width),
@@ -338,7 +350,7 @@ impl App {
         };
         match loaded {
             Err((message, at)) => {
-                eprintln!("glint: {message}; keeping the last good scene");
+                crate::errln!("glint: {message}; keeping the last good scene");
                 self.log(
                     json!({"event": "reload", "ok": false, "frame": self.frame, "error": message}),
                 );
@@ -353,7 +365,7 @@ impl App {
                 self.scene = scene;
                 self.rebuild_renderer()?;
                 if self.scene_error.take().is_some() {
-                    eprintln!("glint: {} reloaded", path.display());
+                    crate::errln!("glint: {} reloaded", path.display());
                 }
                 self.log(json!({"event": "reload", "ok": true, "frame": self.frame}));
                 self.title.since -= TITLE_INTERVAL;
@@ -379,7 +391,7 @@ impl App {
             .write(path)
             .with_context(|| format!("writing {}", path.display()))?;
         let spp = gpu.renderer.samples();
-        eprintln!("glint view: saved {} ({spp} spp)", path.display());
+        crate::errln!("glint view: saved {} ({spp} spp)", path.display());
         self.log(json!({"event": "saved", "path": path.display().to_string(), "spp": spp}));
         Ok(())
     }
@@ -443,7 +455,10 @@ impl App {
             self.apply(action, event_loop)?;
         }
         if self.watch.changed(false) {
-            self.reload()?;
+            self.loader.request();
+        }
+        if let Some(loaded) = self.loader.poll() {
+            self.apply_loaded(loaded)?;
         }
         if self.finished {
             return Ok(());

@@ -14,7 +14,7 @@ pub mod input;
 pub mod watch;
 
 use crate::error::InputError;
-use crate::output::check_output_path;
+use crate::output_check::OutputSet;
 use crate::scene::{RenderOverrides, Scene};
 use action::Script;
 use anyhow::Result;
@@ -64,9 +64,10 @@ pub fn run(options: ViewOptions) -> Result<()> {
             ..Default::default()
         })
         .map_err(|m| InputError(format!("{}: {m}", options.scene.display())))?;
-    if let Some(shot) = &options.screenshot {
-        check_output_path(shot).map_err(InputError)?;
-    }
+    OutputSet::new()
+        .input("the scene file", &options.scene)
+        .image_opt("--screenshot", options.screenshot.as_deref())
+        .check()?;
     if !display_available() {
         return Err(InputError(format!(
             "no display: glint view opens a window, but neither DISPLAY nor WAYLAND_DISPLAY is set; {NO_DISPLAY_HINT}"

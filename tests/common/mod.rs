@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod merge_bound;
 pub mod probe;
 
 use glint::cpu::renderer::CpuRenderer;
