@@ -192,6 +192,30 @@ fn render_denoise_writes_denoised_raw_and_aovs() {
         "AOVs changed the raw image"
     );
     assert!(read("out.exr") != read("raw.exr"));
+    // --raw is a partial file like any render's .exr: a render without AOVs resumes it.
+    let resume_args = [
+        "render",
+        scene,
+        "--cpu",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--spp",
+        "6",
+        "--seed",
+        "5",
+        "--resume",
+        "raw.exr",
+        "-o",
+        "resumed.exr",
+    ];
+    let out = glint(dir.path(), &resume_args, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let albedo = read("albedo.exr");
     assert!(albedo
         .pixels
@@ -216,13 +240,22 @@ fn denoise_and_tone_mapping_bad_input() {
         (vec!["-o", "x.tiff", "--denoise"], "x.tiff"),
         (
             vec!["-o", "x.png", "--denoise", "--raw", "raw.png"],
-            "--raw needs an .exr",
+            "--raw raw.png: needs an .exr",
         ),
         (vec!["-o", "x.png", "--denoise", "--raw", "x.png"], "x.png"),
         (vec!["-o", "x.png", "--raw", "raw.exr"], "--denoise"),
         (
             vec!["-o", "x.png", "--albedo", "x.png"],
-            "--albedo needs an .exr",
+            "--albedo x.png: needs an .exr",
+        ),
+        // AOV means are not kept in partial files: a partial or resumed render has none.
+        (
+            vec!["-o", "x.exr", "--denoise", "--samples", "0..1"],
+            "--samples",
+        ),
+        (
+            vec!["-o", "x.exr", "--albedo", "a.exr", "--shard", "0/2"],
+            "--shard",
         ),
         (
             vec!["-o", "x.png", "--normal", "n.exr", "--depth", "n.exr"],

@@ -13,7 +13,10 @@ use crate::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
     relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
 };
-use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use crate::scene::{
+    KernelScene, RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
+use crate::shader_types::Params;
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -151,7 +154,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
     args.post.configure(&mut kernel_scene.params);
     let settings = &scene.render;
     let (width, height) = (settings.width, settings.height);
-    let settings_hash = settings_hash(&kernel_scene);
+    // AOVs leave the image bit for bit the same (tests/aov.rs), so --denoise's --raw file
+    // resumes and merges with renders made without them.
+    let settings_hash = settings_hash(&KernelScene {
+        params: Params {
+            aovs: 0,
+            ..kernel_scene.params
+        },
+        ..kernel_scene.clone()
+    });
     let plan = sample_range::plan(&args.range, settings.spp, &settings_hash, (width, height))?;
     let output = args.output.clone().unwrap_or_else(|| {
         sample_range::default_output(&args.scene, &plan, &args.range, settings.spp)
