@@ -15,6 +15,18 @@ struct PathState {
     bsdf_pdf_of_ray: f32,
     bounce: u32,
     came_from_delta: bool,
+    // Albedo, normal and depth for the denoiser (aov.wgsl); untouched unless AOVS.
+    aov: PathAov,
+}
+
+// Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
+// most params.radiance_clamp in its brightest channel, hue kept; 0 turns it off.
+fn firefly_clamp(contribution: vec3<f32>, scatterings: u32) -> vec3<f32> {
+    let peak = max(contribution.x, max(contribution.y, contribution.z));
+    if scatterings > 0u && params.radiance_clamp > 0.0 && peak > params.radiance_clamp {
+        return contribution * (params.radiance_clamp / peak);
+    }
+    return contribution;
 }
 
 fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
@@ -22,7 +34,7 @@ fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let ray = camera_ray(px, py, jitter, lens);
-    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true);
+    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true, aov_start());
 }
 
 // Traces one segment of the path (and its shadow ray); true when the path has ended.
@@ -33,10 +45,16 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {
-        (*path).radiance += (*path).throughput * params.background;
+        if aovs_on() {
+            (*path).aov = aov_record_miss((*path).aov);
+        }
+        (*path).radiance += firefly_clamp((*path).throughput * params.background, bounce);
         return true;
     }
     let m = materials[hit.material];
+    if aovs_on() {
+        (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
+    }
     if any(m.emission > vec3<f32>(0.0)) {
         // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
         // from the previous vertex; camera rays and delta bounces count in full.
@@ -45,7 +63,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
             let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
             weight = power_heuristic((*path).bsdf_pdf_of_ray, pdf);
         }
-        (*path).radiance += (*path).throughput * m.emission * weight;
+        (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, bounce);
     }
     // max_bounces counts scattering events; this also bounds every path's length.
     if bounce >= params.max_bounces {
@@ -64,7 +82,8 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
                 segments += 1u;
                 if first_hit_is(Ray(origin, light.dir), light.primitive, light.index) {
                     let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
-                    (*path).radiance += (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
+                    let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
+                    (*path).radiance += firefly_clamp(contribution, bounce + 1u);
                 }
             }
         }
@@ -96,15 +115,15 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     return false;
 }
 
-// Radiance carried by one camera path through pixel (px, py).
-fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> vec3<f32> {
+// One camera path through pixel (px, py), traced to its end: its radiance, and its AOVs.
+fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
     var path = start_path(pixel, px, py, sample);
     loop {
         if path_step(&path, pixel, sample) {
             break;
         }
     }
-    return path.radiance;
+    return path;
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -116,6 +135,7 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let pixel = py * params.width + px;
     var acc = accumulator_start(params.accumulated_samples, accum_mean[pixel].xyz, accum_m2[pixel].xyz);
+    var aov_mean = aov_mean_start();
     // Path regeneration: one loop over segments, and a lane whose path ends starts its next
     // sample at once, instead of idling until the longest path among its SIMD neighbours
     // ends. Each sample's result is the same as trace_path's (the random numbers depend on
@@ -125,6 +145,9 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
     loop {
         if path_step(&path, pixel, params.sample_start + done) {
             add_sample(&acc, path.radiance, params.sample_start + done);
+            if aovs_on() {
+                aov_mean_add(&aov_mean, path.aov, done);
+            }
             done += 1u;
             if done == params.sample_count {
                 break;
@@ -143,6 +166,9 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
     merge_block(&acc);
     accum_mean[pixel] = vec4<f32>(acc.mean, 0.0);
     accum_m2[pixel] = vec4<f32>(acc.m2, 0.0);
+    if aovs_on() {
+        aov_merge(pixel, aov_mean, f32(params.accumulated_samples), f32(params.sample_count));
+    }
     atomicAdd(&segments_traced, segments);
     if acc.nonfinite > 0u {
         atomicAdd(&accumulate_counters[0], acc.nonfinite);

@@ -32,12 +32,14 @@ struct Params {
     // Samples already in the accumulators (the pairwise merge's n_old): sample_start less
     // the first sample of a partial render (--samples A..B), which need not start at 0.
     accumulated_samples: u32,
-    pad1: u32,
-    // Meshes (issue 11), in a block of their own so the fields above keep their offsets.
+    // 1: accumulate the denoiser's albedo, normal and depth (aov.wgsl); needs AOVS compiled in.
+    aovs: u32,
+    // Firefly clamp: the most a contribution of scattered light may add (0: off; trace.wgsl).
+    radiance_clamp: f32,
+    // Meshes (issue 11).
     triangle_count: u32,
     pad2: u32,
     pad3: u32,
-    pad4: u32,
 }
 
 struct Sphere {

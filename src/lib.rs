@@ -9,11 +9,13 @@
 #![warn(clippy::print_stdout, clippy::print_stderr)]
 
 pub mod accumulation;
+pub mod aov;
 pub mod atomic_write;
 pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod cpu;
+pub mod denoise;
 pub mod error;
 pub mod gpu;
 pub mod input_file;
@@ -27,4 +29,5 @@ pub mod scene;
 pub mod shader;
 pub mod shader_types;
 pub mod stdio;
+pub mod tonemap;
 pub mod viewer;

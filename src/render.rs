@@ -3,9 +3,10 @@
 //! count or the time limit is reached.
 
 use crate::accumulation::Accumulation;
+use crate::aov::Aovs;
 use crate::cpu::accumulate::next_block_end;
 use crate::output::Image;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -31,6 +32,11 @@ pub trait Renderer {
     /// The variance of each pixel's mean estimate (σ²/n per channel, from the unbiased sample
     /// variance); zero before two samples.
     fn read_variance(&mut self) -> Result<Image>;
+    /// The mean albedo, normal and depth per pixel, for the denoiser; an error unless the
+    /// scene's `Params::aovs` asked for them.
+    fn read_aovs(&mut self) -> Result<Aovs> {
+        Err(anyhow!("this renderer does not accumulate AOVs"))
+    }
     /// Forgets all samples (the first sample stays where it was).
     fn reset(&mut self) -> Result<()>;
     /// Ray segments traced since the last reset (camera, bounce and shadow rays), where the

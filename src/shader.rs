@@ -8,7 +8,7 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 12] = [
+pub const SHADER_PARTS: [(&str, &str); 13] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -18,6 +18,7 @@ pub const SHADER_PARTS: [(&str, &str); 12] = [
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
+    ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
     (
         "accumulate.wgsl",
         include_str!("../shaders/accumulate.wgsl"),
@@ -150,6 +151,8 @@ pub struct KernelFeatures {
     pub triangle_emitters: bool,
     pub metal: bool,
     pub dielectric: bool,
+    /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/aov.wgsl).
+    pub aovs: bool,
 }
 
 impl KernelFeatures {
@@ -161,6 +164,7 @@ impl KernelFeatures {
         triangle_emitters: true,
         metal: true,
         dielectric: true,
+        aovs: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -174,6 +178,7 @@ impl KernelFeatures {
             triangle_emitters: emits(PRIMITIVE_TRIANGLE),
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
+            aovs: scene.params.aovs != 0,
         }
     }
 
@@ -186,6 +191,7 @@ impl KernelFeatures {
             && needs(self.triangle_emitters, other.triangle_emitters)
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
+            && needs(self.aovs, other.aovs)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -193,13 +199,14 @@ impl KernelFeatures {
         format!(
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
-             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\n",
+             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
             self.triangle_emitters,
             self.metal,
-            self.dielectric
+            self.dielectric,
+            self.aovs
         )
     }
 }

@@ -36,12 +36,14 @@ pub struct Params {
     /// Samples already in the accumulators (the pairwise merge's n_old): `sample_start` less
     /// the first sample of a partial render (`--samples A..B`), which need not start at 0.
     pub accumulated_samples: u32,
-    pub pad1: u32,
-    /// Meshes (issue 11), in a block of their own so the fields above keep their offsets.
+    /// 1: accumulate the denoiser's albedo, normal and depth; needs `KernelFeatures::aovs`.
+    pub aovs: u32,
+    /// Firefly clamp: the most a contribution of scattered light may add (0: off).
+    pub radiance_clamp: f32,
+    /// Meshes (issue 11).
     pub triangle_count: u32,
     pub pad2: u32,
     pub pad3: u32,
-    pub pad4: u32,
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.

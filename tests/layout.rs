@@ -102,11 +102,11 @@ fn rust_structs_match_wgsl_layout() {
             emitter_count,
             roulette_start,
             accumulated_samples,
-            pad1,
+            aovs,
+            radiance_clamp,
             triangle_count,
             pad2,
-            pad3,
-            pad4
+            pad3
         ]
     );
     assert_same_layout!(
@@ -262,14 +262,15 @@ fn every_feature_combination_validates() {
         materials: 5,
         emitters: 1,
     };
-    for bits in 0..64u32 {
+    for bits in 0..128u32 {
         let features = KernelFeatures {
             light_sampling: bits & 1 != 0,
             sphere_emitters: bits & 2 != 0,
             quad_emitters: bits & 4 != 0,
             metal: bits & 8 != 0,
             dielectric: bits & 16 != 0,
-            triangle_emitters: bits & 32 != 0,
+            aovs: bits & 32 != 0,
+            triangle_emitters: bits & 64 != 0,
         };
         for binding in [
             SceneBinding::Storage,

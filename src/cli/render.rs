@@ -1,5 +1,6 @@
 //! `glint render`.
 
+use super::post::PostArgs;
 use super::render_writer::RenderWriter;
 use super::sample_range::{self, SampleRangeArgs};
 use crate::cpu::renderer::CpuRenderer;
@@ -12,7 +13,10 @@ use crate::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
     relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
 };
-use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use crate::scene::{
+    KernelScene, RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
+use crate::shader_types::Params;
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -72,6 +76,8 @@ pub struct RenderArgs {
     /// ("wall_seconds" is the whole command).
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub post: PostArgs,
     #[command(flatten)]
     pub range: SampleRangeArgs,
     /// Refresh the output with the running image (a resumable partial file for .exr) every
@@ -140,21 +146,34 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let scene = scene
         .with_overrides(&overrides)
         .map_err(|m| InputError(format!("{}: {m}", args.scene.display())))?;
-    let kernel_scene = scene
+    let range = &args.range;
+    args.post.refuse_partial(
+        range.samples.is_some() || range.shard.is_some() || range.resume.is_some(),
+    )?;
+    let mut kernel_scene = scene
         .try_kernel_scene()
         .map_err(|e| InputError(format!("{}: {e}", args.scene.display())))?;
+    args.post.configure(&mut kernel_scene.params);
     let settings = &scene.render;
     let (width, height) = (settings.width, settings.height);
-    let settings_hash = settings_hash(&kernel_scene);
+    // AOVs leave the image bit for bit the same (tests/aov.rs), so --denoise's --raw file
+    // resumes and merges with renders made without them.
+    let settings_hash = settings_hash(&KernelScene {
+        params: Params {
+            aovs: 0,
+            ..kernel_scene.params
+        },
+        ..kernel_scene.clone()
+    });
     let plan = sample_range::plan(&args.range, settings.spp, &settings_hash, (width, height))?;
     let output = args.output.clone().unwrap_or_else(|| {
         sample_range::default_output(&args.scene, &plan, &args.range, settings.spp)
     });
-    OutputSet::new()
+    let outputs = OutputSet::new()
         .input("the scene file", &args.scene)
         .image("-o", &output)
-        .exr_opt("--variance", args.variance.as_deref())
-        .check()?;
+        .exr_opt("--variance", args.variance.as_deref());
+    args.post.outputs(outputs).check()?;
     if plan.is_partial(settings.spp) && ImageFormat::from_path(&output) != Ok(ImageFormat::Exr) {
         return Err(InputError(format!(
             "{}: a partial render (samples {} of {}) needs an .exr output to hold what a merge needs",
@@ -164,6 +183,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         ))
         .into());
     }
+    args.post.check()?;
 
     let gpu = open_gpu(&args)?;
     let mut renderer: Box<dyn Renderer + '_> = match &gpu {
@@ -172,9 +192,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
     };
 
     plan.start(renderer.as_mut())?;
+    // With --denoise, -o is the denoised image, written at the end; the mean goes to --raw.
+    let writer_output = if args.post.denoise {
+        args.post.raw.clone()
+    } else {
+        Some(output.clone())
+    };
     let mut writer = RenderWriter::new(
-        output.clone(),
+        writer_output,
         args.variance.clone(),
+        args.post.display_transform(),
         PartialInfo {
             ranges: Vec::new(),
             target: plan.target.clone(),
@@ -234,6 +261,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     let (mean, variance) = writer.finish(renderer.as_mut())?;
+    let denoise_seconds = args.post.finish(renderer.as_mut(), &mean, &output)?;
     let first = renderer.first_sample();
 
     let nonfinite = renderer.nonfinite_samples();
@@ -270,6 +298,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "bvh_nodes": kernel_scene.bvh_nodes.len(),
             "bvh_build_seconds": kernel_scene.bvh_build_seconds,
             "scene_bytes": kernel_scene.scene_bytes(),
+            "denoise_seconds": denoise_seconds,
             "samples": [first, first + stats.spp],
         });
         crate::outln!("{summary}");

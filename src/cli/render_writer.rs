@@ -1,29 +1,51 @@
 //! Writing a render's outputs, at checkpoints and at the end: the image (a resumable partial
 //! file when it is an .exr) and the variance image. A checkpoint that cannot be written (a full
 //! disk, a deleted folder) does not stop the render: glint warns once and tries again at the
-//! next checkpoint; only a failed final write is an error.
+//! next checkpoint; only a failed final write is an error. With --denoise the image goes to
+//! --raw (or nowhere), as `-o` is then the denoised image (src/cli/post.rs).
 
-use crate::output::Image;
-use crate::partial::{write_image, Partial, PartialInfo};
+use crate::output::{Image, ImageFormat};
+use crate::partial::{Partial, PartialInfo};
 use crate::render::Renderer;
+use crate::tonemap::DisplayTransform;
 use anyhow::{Context, Result};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub struct RenderWriter {
-    pub output: PathBuf,
+    /// The running image: a partial file for .exr, the tone-mapped mean for .png.
+    pub output: Option<PathBuf>,
     pub variance: Option<PathBuf>,
+    /// How a .png output shows radiance (--tonemap, --exposure).
+    pub display: DisplayTransform,
     /// The partial file's header; its ranges are filled in from the renderer at each write.
     pub info: PartialInfo,
     checkpoint_warned: bool,
 }
 
 impl RenderWriter {
-    pub fn new(output: PathBuf, variance: Option<PathBuf>, info: PartialInfo) -> RenderWriter {
+    pub fn new(
+        output: Option<PathBuf>,
+        variance: Option<PathBuf>,
+        display: DisplayTransform,
+        info: PartialInfo,
+    ) -> RenderWriter {
         RenderWriter {
             output,
             variance,
+            display,
             info,
             checkpoint_warned: false,
+        }
+    }
+
+    /// A partial file for .exr (resumable, mergeable); the tone-mapped mean for .png.
+    fn write_image(&self, path: &Path, partial: &Partial) -> Result<()> {
+        match ImageFormat::from_path(path).map_err(anyhow::Error::msg)? {
+            ImageFormat::Exr => partial.write(path),
+            _ => self
+                .display
+                .image(&partial.accumulation.mean_image())
+                .write(path),
         }
     }
 
@@ -37,12 +59,15 @@ impl RenderWriter {
 
     /// Refreshes the output with the running image; a write error is a warning (once).
     pub fn checkpoint(&mut self, renderer: &mut dyn Renderer) -> Result<()> {
+        let Some(output) = &self.output else {
+            return Ok(());
+        };
         let partial = self.partial(renderer)?;
-        if let Err(e) = write_image(&self.output, &partial) {
+        if let Err(e) = self.write_image(output, &partial) {
             if !self.checkpoint_warned {
                 crate::errln!(
                     "glint: warning: cannot write the checkpoint {}: {e:#}; rendering on and trying again at the next checkpoint",
-                    self.output.display()
+                    output.display()
                 );
                 self.checkpoint_warned = true;
             }
@@ -53,8 +78,10 @@ impl RenderWriter {
     /// Writes the image and the variance image; returns both.
     pub fn finish(&mut self, renderer: &mut dyn Renderer) -> Result<(Image, Image)> {
         let partial = self.partial(renderer)?;
-        write_image(&self.output, &partial)
-            .with_context(|| format!("writing {}", self.output.display()))?;
+        if let Some(output) = &self.output {
+            self.write_image(output, &partial)
+                .with_context(|| format!("writing {}", output.display()))?;
+        }
         let variance = partial.accumulation.variance_image();
         if let Some(path) = &self.variance {
             variance

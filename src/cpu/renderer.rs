@@ -2,10 +2,11 @@
 
 use super::trace::{render_pixel, PixelStats, SceneRefs};
 use crate::accumulation::Accumulation;
+use crate::aov::Aovs;
 use crate::output::Image;
 use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use rayon::prelude::*;
 
 pub struct CpuRenderer {
@@ -101,6 +102,26 @@ impl Renderer for CpuRenderer {
     fn read_variance(&mut self) -> Result<Image> {
         let n = self.samples;
         Ok(self.image(|s| variance_of_mean(s.m2.into(), n)))
+    }
+
+    fn read_aovs(&mut self) -> Result<Aovs> {
+        if self.scene.params.aovs == 0 {
+            return Err(anyhow!(
+                "this render does not accumulate AOVs (Params::aovs is 0)"
+            ));
+        }
+        let albedo_depth: Vec<[f32; 4]> = self
+            .stats
+            .iter()
+            .map(|s| s.aov.albedo.extend(s.aov.depth).into())
+            .collect();
+        let normal: Vec<[f32; 4]> = self
+            .stats
+            .iter()
+            .map(|s| s.aov.normal.extend(0.0).into())
+            .collect();
+        let p = &self.scene.params;
+        Ok(Aovs::from_vec4s(p.width, p.height, &albedo_depth, &normal))
     }
 
     fn reset(&mut self) -> Result<()> {

@@ -1,6 +1,9 @@
 //! Path tracing (WGSL side: `shaders/trace.wgsl`).
 
 use super::accumulate::{accumulator_start, add_sample, merge_block};
+use super::aov::{
+    aov_mean_add, aov_merge, aov_record_hit, aov_record_miss, aov_start, aovs_on, AovMean, PathAov,
+};
 use super::camera::camera_ray;
 use super::intersect::{crosses_shading_side, first_hit_is, intersect_scene, Geometry, NO_HIT};
 use super::lights::{light_pdf, power_heuristic, sample_light};
@@ -69,6 +72,18 @@ pub struct PathState {
     pub bsdf_pdf_of_ray: f32,
     pub bounce: u32,
     pub came_from_delta: bool,
+    /// Albedo, normal and depth for the denoiser (aov.rs); untouched unless `params.aovs`.
+    pub aov: PathAov,
+}
+
+/// Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
+/// most `params.radiance_clamp` in its brightest channel, hue kept; 0 turns it off.
+pub fn firefly_clamp(params: &Params, contribution: Vec3, scatterings: u32) -> Vec3 {
+    let peak = contribution.x.max(contribution.y.max(contribution.z));
+    if scatterings > 0 && params.radiance_clamp > 0.0 && peak > params.radiance_clamp {
+        return contribution * (params.radiance_clamp / peak);
+    }
+    contribution
 }
 
 pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
@@ -84,6 +99,7 @@ pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) ->
         bsdf_pdf_of_ray: 0.0,
         bounce: 0,
         came_from_delta: true,
+        aov: aov_start(),
     }
 }
 
@@ -103,10 +119,20 @@ pub fn path_step(
     let hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
-        path.radiance += path.throughput * Vec3::from(params.background);
+        if aovs_on(params) {
+            aov_record_miss(&mut path.aov, params);
+        }
+        path.radiance += firefly_clamp(
+            params,
+            path.throughput * Vec3::from(params.background),
+            bounce,
+        );
         return true;
     }
     let m = &scene.materials[hit.material as usize];
+    if aovs_on(params) {
+        aov_record_hit(&mut path.aov, bounce, &hit, m);
+    }
     let emission = Vec3::from(m.emission);
     if emission.cmpgt(Vec3::ZERO).any() {
         // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
@@ -123,7 +149,7 @@ pub fn path_step(
             );
             weight = power_heuristic(path.bsdf_pdf_of_ray, pdf);
         }
-        path.radiance += path.throughput * emission * weight;
+        path.radiance += firefly_clamp(params, path.throughput * emission * weight, bounce);
     }
     // max_bounces counts scattering events; this also bounds every path's length.
     if bounce >= params.max_bounces {
@@ -147,8 +173,9 @@ pub fn path_step(
                 if first_hit_is(&scene.geometry(), &shadow, light.primitive, light.index) {
                     let weight =
                         power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
-                    path.radiance +=
+                    let contribution =
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);
+                    path.radiance += firefly_clamp(params, contribution, bounce + 1);
                 }
             }
         }
@@ -192,7 +219,7 @@ pub fn path_step(
     false
 }
 
-/// Radiance carried by one camera path through pixel (px, py).
+/// One camera path through pixel (px, py), traced to its end: its radiance, and its AOVs.
 pub fn trace_path(
     scene: &SceneRefs,
     pixel: u32,
@@ -200,10 +227,10 @@ pub fn trace_path(
     py: u32,
     sample: u32,
     segments: &mut u32,
-) -> Vec3 {
+) -> PathState {
     let mut path = start_path(scene.params, pixel, px, py, sample);
     while !path_step(scene, &mut path, pixel, sample, segments) {}
-    path.radiance
+    path
 }
 
 /// Running per-pixel statistics: the mean radiance and M2, the sum of squared deviations.
@@ -213,6 +240,8 @@ pub struct PixelStats {
     pub m2: Vec3,
     /// Samples dropped as NaN, infinite or too large (`shaders/accumulate.wgsl`).
     pub nonfinite: u32,
+    /// Mean albedo, normal and depth, when `params.aovs` asks for them.
+    pub aov: AovMean,
 }
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
@@ -223,16 +252,24 @@ pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats)
     let params = scene.params;
     let pixel = py * params.width + px;
     let mut acc = accumulator_start(params.accumulated_samples, stats.mean, stats.m2);
+    let mut aov_mean = AovMean::default();
     let mut segments = 0;
     for i in 0..params.sample_count {
         let sample = params.sample_start + i;
-        let x = trace_path(scene, pixel, px, py, sample, &mut segments);
-        add_sample(&mut acc, x, sample);
+        let path = trace_path(scene, pixel, px, py, sample, &mut segments);
+        add_sample(&mut acc, path.radiance, sample);
+        if aovs_on(params) {
+            aov_mean_add(&mut aov_mean, &path.aov, i);
+        }
     }
     // A batch ended inside a block (the render loop avoids this) keeps the statistics right.
     merge_block(&mut acc);
     stats.mean = acc.mean;
     stats.m2 = acc.m2;
     stats.nonfinite += acc.nonfinite;
+    if aovs_on(params) {
+        let n_old = params.accumulated_samples as f32;
+        aov_merge(&mut stats.aov, &aov_mean, n_old, params.sample_count as f32);
+    }
     segments
 }

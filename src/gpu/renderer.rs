@@ -8,6 +8,7 @@ use super::loop_budget::{
 };
 use super::tiles::{next_tile, TilePlanner};
 use crate::accumulation::Accumulation;
+use crate::aov::Aovs;
 use crate::output::Image;
 use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
@@ -31,6 +32,9 @@ pub struct GpuRenderer<'a> {
     mean_buffer: wgpu::Buffer,
     /// Per pixel vec4: M2, the sum of squared deviations from the mean (xyz).
     m2_buffer: wgpu::Buffer,
+    /// Per pixel vec4s of the denoiser's AOVs (shaders/aov.wgsl): albedo and depth, normal.
+    /// One vec4 each when the kernel has AOVs compiled out.
+    aov_buffers: [wgpu::Buffer; 2],
     readback_buffer: wgpu::Buffer,
     samples: u32,
     first_sample: u32,
@@ -144,6 +148,11 @@ impl<'a> GpuRenderer<'a> {
         let params = scene.params;
         let pixel_count = params.width as u64 * params.height as u64;
         let accum_size = pixel_count * 16;
+        let aov_size = if variant.features.aovs {
+            accum_size
+        } else {
+            16
+        };
         let (usage, scene_type) = match variant.binding {
             SceneBinding::Storage | SceneBinding::Bvh => (
                 wgpu::BufferUsages::STORAGE,
@@ -177,6 +186,8 @@ impl<'a> GpuRenderer<'a> {
                 ),
                 BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
+                BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
+                BufferNeed::new("aov_normal", aov_size, BufferBinding::Storage),
             ],
         )?;
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -233,6 +244,16 @@ impl<'a> GpuRenderer<'a> {
         });
         let mean_buffer = accumulator("accum_mean");
         let m2_buffer = accumulator("accum_m2");
+        let aov_buffers = ["aov_albedo_depth", "aov_normal"].map(|label| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: aov_size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
         let readback_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: accum_size,
@@ -256,6 +277,8 @@ impl<'a> GpuRenderer<'a> {
                 (9, read_only, &triangle_normals),
                 (12, read_only, &bvh_nodes),
                 (13, read_only, &bvh_primitives),
+                (10, read_write, &aov_buffers[0]),
+                (11, read_write, &aov_buffers[1]),
                 (16, read_write, &nonfinite_buffer),
                 (17, wgpu::BufferBindingType::Uniform, &tile_buffer),
             ],
@@ -281,6 +304,7 @@ impl<'a> GpuRenderer<'a> {
             params_buffer,
             mean_buffer,
             m2_buffer,
+            aov_buffers,
             readback_buffer,
             samples: 0,
             first_sample: 0,
@@ -420,6 +444,11 @@ impl<'a> GpuRenderer<'a> {
                 "set_params cannot change the image size; make a new renderer"
             ));
         }
+        if params.aovs != 0 && !self.variant.features.aovs {
+            return Err(anyhow!(
+                "set_params cannot turn on AOVs compiled out of the kernel; make a new renderer"
+            ));
+        }
         if params.light_sampling != 0 && !self.variant.features.light_sampling {
             return Err(anyhow!(
                 "set_params cannot turn on light sampling compiled out of the kernel; make a new renderer"
@@ -427,6 +456,17 @@ impl<'a> GpuRenderer<'a> {
         }
         self.params = params;
         self.reset()
+    }
+
+    /// Each vec4 of `buffer`, which is at most as large as the readback buffer.
+    fn read_vec4s(&self, buffer: &wgpu::Buffer) -> Result<Vec<[f32; 4]>> {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &self.readback_buffer, 0, buffer.size());
+        self.ctx.queue.submit([encoder.finish()]);
+        let size = buffer.size() as usize;
+        self.ctx.read_mapped(&self.readback_buffer, |bytes| {
+            bytemuck::cast_slice::<u8, [f32; 4]>(&bytes[..size]).to_vec()
+        })
     }
 
     /// One submission: the batch in `self.params` over the pixels of `tile`, waited for.
@@ -621,8 +661,23 @@ impl Renderer for GpuRenderer<'_> {
         Ok(self.image(m2.into_iter().map(|v| variance_of_mean(v, n)).collect()))
     }
 
+    fn read_aovs(&mut self) -> Result<Aovs> {
+        if self.params.aovs == 0 {
+            return Err(anyhow!(
+                "this render does not accumulate AOVs (Params::aovs is 0)"
+            ));
+        }
+        let albedo_depth = self.read_vec4s(&self.aov_buffers[0])?;
+        let normal = self.read_vec4s(&self.aov_buffers[1])?;
+        let (width, height) = (self.params.width, self.params.height);
+        Ok(Aovs::from_vec4s(width, height, &albedo_depth, &normal))
+    }
+
     fn reset(&mut self) -> Result<()> {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        for buffer in &self.aov_buffers {
+            encoder.clear_buffer(buffer, 0, None);
+        }
         encoder.clear_buffer(&self.mean_buffer, 0, None);
         encoder.clear_buffer(&self.m2_buffer, 0, None);
         encoder.clear_buffer(&self.counter_buffer, 0, None);

@@ -97,11 +97,11 @@ impl Scene {
                 ROULETTE_OFF
             },
             accumulated_samples: 0,
-            pad1: 0,
+            aovs: 0,
+            radiance_clamp: 0.0,
             triangle_count: self.triangles.len() as u32,
             pad2: 0,
             pad3: 0,
-            pad4: 0,
         };
         let spheres = self
             .spheres

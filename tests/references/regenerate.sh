@@ -13,3 +13,7 @@ out=tests/references
     -o "$out/cornell-diffuse-64.exr" --variance "$out/cornell-diffuse-64.variance.exr" --json
 "$glint" render "$out/sky-diffuse.toml" --cpu --width 64 --height 36 --spp 16384 --seed 1000 \
     -o "$out/sky-diffuse-64x36.exr" --variance "$out/sky-diffuse-64x36.variance.exr" --json
+# The denoising test's reference (tests/denoise.rs): the shipped Cornell box, mirror sphere and
+# all, at 256² on the GPU (about 20 minutes on 2 busy cores with lavapipe).
+"$glint" render scenes/cornell.toml --gpu --width 256 --height 256 --spp 4096 --seed 1000 \
+    -o "$out/cornell-256.exr" --json
