@@ -204,56 +204,35 @@ impl<'a> GpuRenderer<'a> {
         let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
         let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
-        let accumulator = |label| {
+        // Buffers the kernel writes and the host clears and reads back.
+        let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: accum_size,
+                size,
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::COPY_SRC
                     | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             })
         };
-        let counter_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("segments_traced"),
-            size: 8,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let counter_buffer = read_write_buffer("segments_traced", 8);
         let tile_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("tile_origin"),
             size: 16,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let nonfinite_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("nonfinite_samples"),
-            size: 8,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let nonfinite_buffer = read_write_buffer("nonfinite_samples", 8);
         let nonfinite_readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("nonfinite readback"),
             size: 8,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mean_buffer = accumulator("accum_mean");
-        let m2_buffer = accumulator("accum_m2");
-        let aov_buffers = ["aov_albedo_depth", "aov_normal"].map(|label| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: aov_size,
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_SRC
-                    | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        });
+        let mean_buffer = read_write_buffer("accum_mean", accum_size);
+        let m2_buffer = read_write_buffer("accum_m2", accum_size);
+        let aov_buffers =
+            ["aov_albedo_depth", "aov_normal"].map(|label| read_write_buffer(label, aov_size));
         let readback_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: accum_size,
