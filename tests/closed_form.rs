@@ -1,7 +1,7 @@
 //! Scenes whose images are known in closed form, rendered on the CPU reference and on the GPU.
 
 mod common;
-use common::{kernel_scene, render_both};
+use common::{kernel_scene, largest_deviation, render_both};
 
 const FURNACE: &str = r#"
 [camera]
@@ -133,12 +133,7 @@ fn white_sphere_under_white_sky_vanishes_at_every_scale() {
     ] {
         let scene = white_sphere(center, radius, 1);
         for (device, image) in render_both(&scene, 4) {
-            let worst = image
-                .pixels
-                .iter()
-                .flatten()
-                .map(|c| (c - 1.0).abs())
-                .fold(0.0, f32::max);
+            let worst = largest_deviation(&image, 1.0);
             assert!(
                 worst < 1e-6,
                 "{device}, sphere r = {radius} at {center:?}: off by {worst}"
@@ -234,12 +229,7 @@ fn white_furnace_objects_vanish() {
         "type = \"dielectric\"\nior = 2.4",
     ] {
         for (device, image) in render_both(&white_furnace(material), 8) {
-            let worst = image
-                .pixels
-                .iter()
-                .flatten()
-                .map(|c| (c - 1.0).abs())
-                .fold(0.0, f32::max);
+            let worst = largest_deviation(&image, 1.0);
             assert!(worst < 1e-5, "{device}, {material:?}: off by {worst}");
         }
     }

@@ -256,12 +256,7 @@ smooth = {smooth}
         std::fs::write(&path, text).unwrap();
         let scene = Scene::load(&path).unwrap().kernel_scene();
         for (device, image) in common::render_both(&scene, 4) {
-            let worst = image
-                .pixels
-                .iter()
-                .flatten()
-                .map(|c| (c - 1.0).abs())
-                .fold(0.0, f32::max);
+            let worst = common::largest_deviation(&image, 1.0);
             assert!(
                 worst < 1e-5,
                 "{device}, {material:?}, smooth {smooth}, B = {bounces}: off by {worst}"

@@ -59,6 +59,17 @@ pub fn render_both(scene: &KernelScene, spp: u32) -> Vec<(&'static str, Image)> 
     out
 }
 
+/// The largest difference of any pixel channel from `value`: the error of a closed-form image
+/// (a furnace, a vanishing white object) that is `value` everywhere.
+pub fn largest_deviation(image: &Image, value: f32) -> f32 {
+    image
+        .pixels
+        .iter()
+        .flatten()
+        .map(|c| (c - value).abs())
+        .fold(0.0, f32::max)
+}
+
 /// The text of a scene file shipped in scenes/.
 pub fn shipped_scene_text(name: &str) -> String {
     std::fs::read_to_string(
