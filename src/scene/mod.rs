@@ -9,6 +9,7 @@
 
 pub mod bvh;
 mod file;
+pub mod image;
 mod kernel;
 pub mod limits;
 pub mod mesh;
