@@ -20,6 +20,8 @@ struct Hit {
     // Which primitive: PRIMITIVE_SPHERE, PRIMITIVE_QUAD or PRIMITIVE_TRIANGLE, and its index.
     primitive: u32,
     index: u32,
+    // Texture coordinates (texture.wgsl); computed only when HAS_TEXTURES.
+    uv: vec2<f32>,
 }
 
 // Nearest t > 0 of a sphere hit, or NO_HIT. The discriminant is r^2 - |oc - h d|^2 rather than
@@ -136,6 +138,9 @@ fn intersect_scene(ray: Ray) -> Hit {
         hit.position = surface.position;
         hit.error = surface.error;
         hit.material = s.material;
+        if HAS_TEXTURES {
+            hit.uv = sphere_uv(outward);
+        }
     } else if HAS_TRIANGLES && closest.primitive == PRIMITIVE_TRIANGLE {
         let tri = triangles[closest.index];
         let b = triangle_barycentrics(tri, triangle_ray(ray));
@@ -145,6 +150,9 @@ fn intersect_scene(ray: Ray) -> Hit {
         hit.position = surface.position;
         hit.error = surface.error;
         hit.material = tri.material;
+        if HAS_TEXTURES {
+            hit.uv = triangle_uv(closest.index, b);
+        }
         let n = triangle_normals[closest.index];
         if n.smooth_shading != 0u {
             shading = normalize(b.x * n.n0 + b.y * n.n1 + b.z * n.n2);
@@ -160,6 +168,9 @@ fn intersect_scene(ray: Ray) -> Hit {
         hit.position = surface.position;
         hit.error = surface.error;
         hit.material = q.material;
+        if HAS_TEXTURES {
+            hit.uv = vec2<f32>(a, b);
+        }
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;
     hit.normal = select(-outward, outward, hit.front_face);

@@ -51,7 +51,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         (*path).radiance += firefly_clamp((*path).throughput * params.background, bounce);
         return true;
     }
-    let m = materials[hit.material];
+    let m = material_at(materials[hit.material], hit.uv);
     if aovs_on() {
         (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
     }

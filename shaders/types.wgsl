@@ -82,7 +82,13 @@ struct Material {
     // GGX alpha (roughness squared) for metal.
     alpha: f32,
     ior: f32,
+    // Texture replacing albedo at the hit, or NO_TEXTURE (texture.wgsl).
+    color_texture: u32,
+    // Texture whose first channel replaces the metal's roughness (alpha = r * r), or NO_TEXTURE.
+    roughness_texture: u32,
 }
+
+const NO_TEXTURE: u32 = 0xffffffffu;
 
 const PRIMITIVE_SPHERE: u32 = 0u;
 const PRIMITIVE_QUAD: u32 = 1u;
@@ -129,6 +135,29 @@ struct Emitter {
     // Sum of the selection probabilities up to and including this emitter (the last is 1).
     cdf: f32,
     probability: f32,
+}
+
+const TEXTURE_IMAGE: u32 = 0u;
+const TEXTURE_CHECKER: u32 = 1u;
+
+// An image whose texels are texels[first_texel ..][.. width * height], bottom row first, or a
+// checker of two colours with `scale` squares per unit of u and of v (texture.wgsl).
+struct Texture {
+    kind: u32,
+    first_texel: u32,
+    width: u32,
+    height: u32,
+    // The checker's colour where floor(u scale) + floor(v scale) is even (the origin's square).
+    color0: vec3<f32>,
+    scale: f32,
+    color1: vec3<f32>,
+}
+
+// A triangle's texture coordinates at its three vertices (zero where the mesh has none).
+struct TriangleUvs {
+    uv0: vec2<f32>,
+    uv1: vec2<f32>,
+    uv2: vec2<f32>,
 }
 
 struct Ray {

@@ -97,8 +97,15 @@ pub struct Material {
     /// GGX alpha (roughness squared) for metal.
     pub alpha: f32,
     pub ior: f32,
-    pub _pad: [u32; 3],
+    /// Index into the texture descriptors replacing `albedo` at the hit, or [`NO_TEXTURE`].
+    pub color_texture: u32,
+    /// Texture whose first channel replaces the metal's roughness (alpha = r²), or [`NO_TEXTURE`].
+    pub roughness_texture: u32,
+    pub _pad: u32,
 }
+
+/// `Material::color_texture` and `roughness_texture` when the value is constant.
+pub const NO_TEXTURE: u32 = u32::MAX;
 
 pub const PRIMITIVE_SPHERE: u32 = 0;
 pub const PRIMITIVE_QUAD: u32 = 1;
@@ -157,3 +164,33 @@ pub struct BvhNode {
 /// A BVH leaf's primitive reference: the kind in the top two bits, the index below.
 pub const PRIMITIVE_KIND_SHIFT: u32 = 30;
 pub const PRIMITIVE_INDEX_MASK: u32 = (1 << PRIMITIVE_KIND_SHIFT) - 1;
+
+pub const TEXTURE_IMAGE: u32 = 0;
+pub const TEXTURE_CHECKER: u32 = 1;
+
+/// A texture (`src/scene/texture.rs` builds them, `shaders/texture.wgsl` reads them): an image
+/// whose texels are `texels[first_texel ..][.. width * height]`, bottom row first, or a checker
+/// of two colours with `scale` squares per unit of u and of v.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Texture {
+    /// `TEXTURE_IMAGE` or `TEXTURE_CHECKER`.
+    pub kind: u32,
+    pub first_texel: u32,
+    pub width: u32,
+    pub height: u32,
+    /// The checker's colour where ⌊u·scale⌋ + ⌊v·scale⌋ is even (the square at the origin).
+    pub color0: [f32; 3],
+    pub scale: f32,
+    pub color1: [f32; 3],
+    pub _pad: u32,
+}
+
+/// A triangle's texture coordinates at its three vertices (zero where the mesh has none).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TriangleUvs {
+    pub uv0: [f32; 2],
+    pub uv1: [f32; 2],
+    pub uv2: [f32; 2],
+}

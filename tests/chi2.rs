@@ -299,6 +299,7 @@ emission = [1.0, 1.0, 1.0]
             vertices: [base[k], base[(k + 1) % 4], apex],
             normals: None,
             material: if k % 2 == 0 { bright } else { dim },
+            uvs: None,
         });
     }
     scene

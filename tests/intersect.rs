@@ -51,6 +51,8 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             kind: MaterialKind::Diffuse,
             color: Vec3::ONE,
             emitted_radiance: Vec3::ZERO,
+            color_texture: None,
+            roughness_texture: None,
         }],
         spheres: vec![],
         quads: vec![SceneQuad {
@@ -60,6 +62,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             material: 0,
         }],
         triangles: vec![],
+        textures: Default::default(),
     };
     scene.kernel_scene().quads[0]
 }

@@ -6,7 +6,8 @@ use glint::shader::{
     SceneCounts, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use glint::shader_types::{
-    BvhNode, Emitter, Material, Params, Quad, Sphere, Triangle, TriangleNormals,
+    BvhNode, Emitter, Material, Params, Quad, Sphere, Texture, Triangle, TriangleNormals,
+    TriangleUvs,
 };
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
@@ -138,7 +139,15 @@ fn rust_structs_match_wgsl_layout() {
         &module,
         Material,
         "Material",
-        [albedo, kind, emission, alpha, ior]
+        [
+            albedo,
+            kind,
+            emission,
+            alpha,
+            ior,
+            color_texture,
+            roughness_texture
+        ]
     );
     assert_same_layout!(
         &module,
@@ -159,6 +168,14 @@ fn rust_structs_match_wgsl_layout() {
         [n0, smooth_shading, n1, n2]
     );
     assert_same_layout!(&module, BvhNode, "BvhNode", [min, first, max, count]);
+    assert_same_layout!(
+        &module,
+        Texture,
+        "Texture",
+        [kind, first_texel, width, height, color0, scale, color1]
+    );
+    assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
+    assert_eq!(size_of::<Material>(), 48, "Material stays 48 bytes");
 }
 
 #[test]
@@ -262,7 +279,7 @@ fn every_feature_combination_validates() {
         materials: 5,
         emitters: 1,
     };
-    for bits in 0..128u32 {
+    for bits in 0..256u32 {
         let features = KernelFeatures {
             light_sampling: bits & 1 != 0,
             sphere_emitters: bits & 2 != 0,
@@ -271,6 +288,7 @@ fn every_feature_combination_validates() {
             dielectric: bits & 16 != 0,
             aovs: bits & 32 != 0,
             triangle_emitters: bits & 64 != 0,
+            textures: bits & 128 != 0,
         };
         for binding in [
             SceneBinding::Storage,

@@ -2,15 +2,16 @@
 
 use super::bvh::{bvh_closest_primitive, bvh_first_hit_is};
 use super::surface::{parametric_point, sphere_point};
+use super::texture::{sphere_uv, triangle_uv};
 use super::triangle::{
     hit_triangle, triangle_barycentrics, triangle_normal, triangle_ray, triangle_surface_point,
 };
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, Quad, Sphere, Triangle, TriangleNormals, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
-    PRIMITIVE_TRIANGLE,
+    BvhNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// The scene's surfaces as the kernel's intersection code reads them. With `bvh_nodes` empty,
 /// every ray tests every primitive (the kernel's `USE_BVH = false`).
@@ -22,6 +23,10 @@ pub struct Geometry<'a> {
     pub triangle_normals: &'a [TriangleNormals],
     pub bvh_nodes: &'a [BvhNode],
     pub bvh_primitives: &'a [u32],
+    /// One per triangle when `textured`.
+    pub triangle_uvs: &'a [TriangleUvs],
+    /// Whether hits need texture coordinates (the kernel's `HAS_TEXTURES`).
+    pub textured: bool,
 }
 
 impl<'a> Geometry<'a> {
@@ -56,6 +61,8 @@ pub struct Hit {
     /// Which primitive: `PRIMITIVE_SPHERE`, `PRIMITIVE_QUAD` or `PRIMITIVE_TRIANGLE`, and its index.
     pub primitive: u32,
     pub index: u32,
+    /// Texture coordinates (`texture.rs`); computed only when `Geometry::textured`.
+    pub uv: Vec2,
 }
 
 /// Nearest t > 0 of a sphere hit, or `NO_HIT`. The discriminant is r² − |oc − h d|² rather
@@ -185,15 +192,20 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
             front_face: false,
             primitive: 0,
             index: 0,
+            uv: Vec2::ZERO,
         };
     }
     // Zero: shade with the geometric normal.
     let mut shading = Vec3::ZERO;
+    let mut uv = Vec2::ZERO;
     let (outward, surface, material) = if closest.primitive == PRIMITIVE_SPHERE {
         let s = &geometry.spheres[closest.index as usize];
         // Normalised, not divided by the radius: a normal a little too long would make
         // reflected directions too long, and the error would grow with every bounce.
         let outward = (ray.origin + closest.t * ray.dir - Vec3::from(s.center)).normalize();
+        if geometry.textured {
+            uv = sphere_uv(outward);
+        }
         (
             outward,
             sphere_point(Vec3::from(s.center), s.radius, outward),
@@ -207,6 +219,9 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
             shading = (b.x * Vec3::from(n.n0) + b.y * Vec3::from(n.n1) + b.z * Vec3::from(n.n2))
                 .normalize();
         }
+        if geometry.textured {
+            uv = triangle_uv(&geometry.triangle_uvs[closest.index as usize], b);
+        }
         // On the triangle's plane: v0 + b1 e1 + b2 e2, from the edges the normal is made of.
         (
             triangle_normal(tri),
@@ -219,6 +234,9 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
         let w = ray.origin + closest.t * ray.dir - Vec3::from(q.corner);
         let a = Vec3::from(q.u_dual).dot(w).clamp(0.0, 1.0);
         let b = Vec3::from(q.v_dual).dot(w).clamp(0.0, 1.0);
+        if geometry.textured {
+            uv = Vec2::new(a, b);
+        }
         (
             Vec3::from(q.normal),
             parametric_point(
@@ -252,6 +270,7 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
         front_face,
         primitive: closest.primitive,
         index: closest.index,
+        uv,
     }
 }
 

@@ -12,6 +12,7 @@ pub mod material;
 pub mod renderer;
 pub mod rng;
 pub mod surface;
+pub mod texture;
 pub mod trace;
 pub mod triangle;
 

@@ -10,10 +10,12 @@ use super::lights::{light_pdf, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::surface::offset_ray_origin;
+use super::texture::{material_at, Textures};
 use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, Material, Params, Quad, Sphere, Triangle, TriangleNormals,
+    BvhNode, Emitter, Material, Params, Quad, Sphere, Texture, Triangle, TriangleNormals,
+    TriangleUvs,
 };
 use glam::Vec3;
 
@@ -29,6 +31,10 @@ pub struct SceneRefs<'a> {
     /// Empty: every ray tests every primitive.
     pub bvh_nodes: &'a [BvhNode],
     pub bvh_primitives: &'a [u32],
+    /// Texture descriptors and texels (`texture.rs`); empty without textures.
+    pub textures: &'a [Texture],
+    pub texels: &'a [[f32; 4]],
+    pub triangle_uvs: &'a [TriangleUvs],
 }
 
 impl<'a> SceneRefs<'a> {
@@ -44,6 +50,17 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: &scene.triangle_normals,
             bvh_nodes: &scene.bvh_nodes,
             bvh_primitives: &scene.bvh_primitives,
+            textures: &scene.textures,
+            texels: &scene.texels,
+            triangle_uvs: &scene.triangle_uvs,
+        }
+    }
+
+    /// What texture lookups read.
+    pub fn textures(&self) -> Textures<'a> {
+        Textures {
+            descriptors: self.textures,
+            texels: self.texels,
         }
     }
 
@@ -56,6 +73,8 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: self.triangle_normals,
             bvh_nodes: self.bvh_nodes,
             bvh_primitives: self.bvh_primitives,
+            triangle_uvs: self.triangle_uvs,
+            textured: !self.textures.is_empty(),
         }
     }
 }
@@ -129,7 +148,11 @@ pub fn path_step(
         );
         return true;
     }
-    let m = &scene.materials[hit.material as usize];
+    let m = &material_at(
+        &scene.textures(),
+        &scene.materials[hit.material as usize],
+        hit.uv,
+    );
     if aovs_on(params) {
         aov_record_hit(&mut path.aov, bounce, &hit, m);
     }

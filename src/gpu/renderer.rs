@@ -184,6 +184,13 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.bvh_primitives),
                     read_only,
                 ),
+                BufferNeed::new("textures", array_bytes(&scene.textures), read_only),
+                BufferNeed::new("texture texels", array_bytes(&scene.texels), read_only),
+                BufferNeed::new(
+                    "triangle texture coordinates",
+                    array_bytes(&scene.triangle_uvs),
+                    read_only,
+                ),
                 BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
@@ -204,6 +211,10 @@ impl<'a> GpuRenderer<'a> {
         let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
         let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+        // Textures are storage buffers in every layout (shaders/texture.wgsl says why).
+        let textures = storage_buffer(ctx, "textures", &scene.textures);
+        let texels = storage_buffer(ctx, "texture texels", &scene.texels);
+        let triangle_uvs = storage_buffer(ctx, "triangle texture coordinates", &scene.triangle_uvs);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -260,6 +271,9 @@ impl<'a> GpuRenderer<'a> {
                 (11, read_write, &aov_buffers[1]),
                 (16, read_write, &nonfinite_buffer),
                 (17, wgpu::BufferBindingType::Uniform, &tile_buffer),
+                (20, read_only, &textures),
+                (21, read_only, &texels),
+                (22, read_only, &triangle_uvs),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -96,8 +96,16 @@ pub(super) struct MaterialToml {
     pub(super) color: Option<S<Triple>>,
     pub(super) emission: Option<S<Triple>>,
     pub(super) strength: Option<S<Real>>,
-    pub(super) roughness: Option<S<Real>>,
+    pub(super) roughness: Option<S<RoughnessToml>>,
     pub(super) ior: Option<S<Real>>,
+}
+
+/// `roughness = 0.3`, or anything else (`{ texture = "…" }`), which validation reads.
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(super) enum RoughnessToml {
+    Value(Real),
+    Other(toml::Value),
 }
 
 #[derive(Deserialize)]

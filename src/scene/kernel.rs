@@ -5,9 +5,9 @@ use super::bvh;
 use super::{CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
-    self, BvhNode, Emitter, Params, TriangleNormals, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
-    MATERIAL_METAL, MATERIAL_SPECULAR, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
-    ROULETTE_OFF,
+    self, BvhNode, Emitter, Params, Texture, TriangleNormals, TriangleUvs, MATERIAL_DIELECTRIC,
+    MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
@@ -26,6 +26,11 @@ pub struct KernelScene {
     pub bvh_nodes: Vec<BvhNode>,
     pub bvh_primitives: Vec<u32>,
     pub bvh_build_seconds: f64,
+    /// Texture descriptors and all images' texels (`scene::texture`); empty without textures.
+    pub textures: Vec<Texture>,
+    pub texels: Vec<[f32; 4]>,
+    /// One per triangle when the scene has textures, else empty.
+    pub triangle_uvs: Vec<TriangleUvs>,
 }
 
 impl KernelScene {
@@ -42,6 +47,9 @@ impl KernelScene {
             + bytes(&self.triangle_normals)
             + bytes(&self.bvh_nodes)
             + bytes(&self.bvh_primitives)
+            + bytes(&self.textures)
+            + bytes(&self.texels)
+            + bytes(&self.triangle_uvs)
     }
 }
 
@@ -155,7 +163,9 @@ impl Scene {
                     emission: m.emitted_radiance.into(),
                     alpha,
                     ior,
-                    _pad: [0; 3],
+                    color_texture: m.color_texture.unwrap_or(NO_TEXTURE),
+                    roughness_texture: m.roughness_texture.unwrap_or(NO_TEXTURE),
+                    _pad: 0,
                 }
             })
             .collect();
@@ -200,6 +210,19 @@ impl Scene {
             bvh_nodes: Vec::new(),
             bvh_primitives: Vec::new(),
             bvh_build_seconds: 0.0,
+            textures: self.textures.descriptors.clone(),
+            texels: self.textures.texels.clone(),
+            triangle_uvs: if self.textures.is_empty() {
+                Vec::new()
+            } else {
+                self.triangles
+                    .iter()
+                    .map(|t| {
+                        let [uv0, uv1, uv2] = t.uvs.unwrap_or_default().map(|uv| uv.into());
+                        TriangleUvs { uv0, uv1, uv2 }
+                    })
+                    .collect()
+            },
         };
         if bvh::wants_bvh(
             scene.spheres.len(),

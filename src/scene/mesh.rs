@@ -5,7 +5,7 @@
 
 use super::{Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::io::{BufRead, Read};
 use std::path::Path;
 
@@ -37,6 +37,8 @@ impl MeshTransform {
 pub(super) struct MeshPart {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
+    /// Texture coordinates (v up), as many as positions, or none.
+    uvs: Vec<Vec2>,
     indices: Vec<[u32; 3]>,
     /// Index into the file's materials, if the file gives one.
     material: Option<usize>,
@@ -177,10 +179,12 @@ pub(super) fn load(
                 })
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
+            let uvs = (part.uvs.len() == count).then(|| idx.map(|i| part.uvs[i as usize]));
             triangles.push(Triangle {
                 vertices: v,
                 normals,
                 material,
+                uvs,
             });
             if triangles.len() > MAX_TRIANGLES {
                 return Err(format!(
@@ -314,6 +318,8 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
             kind,
             color,
             emitted_radiance: emission,
+            color_texture: None,
+            roughness_texture: None,
         },
         textures,
     ))
@@ -360,6 +366,11 @@ fn read_obj(path: &Path) -> Result<MeshFile, String> {
             MeshPart {
                 positions: triples(&mesh.positions),
                 normals: triples(&mesh.normals),
+                uvs: mesh
+                    .texcoords
+                    .chunks_exact(2)
+                    .map(Vec2::from_slice)
+                    .collect(),
                 indices: mesh
                     .indices
                     .chunks_exact(3)
@@ -462,6 +473,7 @@ fn read_ply(path: &Path) -> Result<MeshFile, String> {
         parts: vec![MeshPart {
             positions,
             normals,
+            uvs: Vec::new(),
             indices,
             material: None,
             name: String::new(),
@@ -510,6 +522,8 @@ fn gltf_material(m: &gltf::Material, index: usize) -> Result<(Material, bool), S
             kind,
             color,
             emitted_radiance: emission,
+            color_texture: None,
+            roughness_texture: None,
         },
         textures,
     ))
@@ -560,6 +574,11 @@ fn read_gltf(path: &Path) -> Result<MeshFile, String> {
                 .read_normals()
                 .map(|n| n.map(|n| normal_matrix * Vec3::from(n)).collect())
                 .unwrap_or_default();
+            // glTF's texture coordinates have v down (the image's top row at v = 0).
+            let uvs: Vec<Vec2> = reader
+                .read_tex_coords(0)
+                .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect())
+                .unwrap_or_default();
             let flat: Vec<u32> = match reader.read_indices() {
                 Some(i) => i.into_u32().collect(),
                 None => (0..positions.len() as u32).collect(),
@@ -567,6 +586,7 @@ fn read_gltf(path: &Path) -> Result<MeshFile, String> {
             parts.push(MeshPart {
                 positions,
                 normals,
+                uvs,
                 indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
                 material: primitive.material().index(),
                 name,

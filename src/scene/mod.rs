@@ -14,13 +14,14 @@ mod kernel;
 pub mod limits;
 pub mod mesh;
 pub mod stress;
+pub mod texture;
 mod validate;
 
 pub use kernel::KernelScene;
 
 use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -74,6 +75,8 @@ pub struct Scene {
     pub quads: Vec<Quad>,
     /// Every mesh's triangles, in the scene's coordinates.
     pub triangles: Vec<Triangle>,
+    /// The textures materials refer to.
+    pub textures: texture::TextureSet,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -82,6 +85,8 @@ pub struct Triangle {
     /// Unit vertex normals to interpolate for shading; `None` shades with the geometric normal.
     pub normals: Option<[Vec3; 3]>,
     pub material: u32,
+    /// Texture coordinates at the vertices (v up), where the file gives them.
+    pub uvs: Option<[Vec2; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -137,7 +142,8 @@ pub struct RenderSettings {
 pub enum MaterialKind {
     Diffuse,
     Specular,
-    /// GGX microfacet conductor; roughness in [0, 1], GGX alpha = roughness².
+    /// GGX microfacet conductor; roughness in [0, 1], GGX alpha = roughness² (unused where
+    /// [`Material::roughness_texture`] is set).
     Metal {
         roughness: f32,
     },
@@ -154,6 +160,10 @@ pub struct Material {
     pub color: Vec3,
     /// `emission * strength`.
     pub emitted_radiance: Vec3,
+    /// Index into [`Scene::textures`] replacing `color` at each hit.
+    pub color_texture: Option<u32>,
+    /// Index into [`Scene::textures`] whose first channel replaces a metal's roughness.
+    pub roughness_texture: Option<u32>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,9 +1,10 @@
 //! From the file as written to a validated [`Scene`]: every range, reference and degenerate
 //! case checked, each failure tied to its field and its place in the file.
 
-use super::file::{Real, ScaleToml, SceneToml, Triple, S};
+use super::file::{Real, RoughnessToml, ScaleToml, SceneToml, Triple, S};
 use super::limits::{MAX_COORDINATE, MAX_IOR, MAX_RADIANCE, MIN_IOR, MIN_LENGTH, MIN_SINE};
 use super::mesh::{self, MeshTransform};
+use super::texture::{TextureSet, TextureUse};
 use super::{
     check_image_size, check_range, Camera, Material, MaterialKind, Quad, RenderSettings, Scene,
     Sphere, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
@@ -285,6 +286,7 @@ impl SceneToml {
         };
 
         let mut materials = Vec::new();
+        let mut textures = TextureSet::default();
         let mut index_of = BTreeMap::new();
         for (name, m) in &self.materials {
             let m = m.get_ref();
@@ -304,10 +306,23 @@ impl SceneToml {
                 "diffuse" => MaterialKind::Diffuse,
                 "specular" => MaterialKind::Specular,
                 "metal" => {
-                    let roughness = positive(&m.roughness, "roughness", "metal")?;
+                    let Some(r) = &m.roughness else {
+                        return fail(
+                            m.kind.span(),
+                            field("roughness"),
+                            "missing: a metal needs roughness",
+                        );
+                    };
+                    let roughness = match r.get_ref() {
+                        RoughnessToml::Value(v) => {
+                            real(&S::new(r.span(), *v), &field("roughness"))?
+                        }
+                        // A texture (read below); the constant is unused.
+                        RoughnessToml::Other(_) => 1.0,
+                    };
                     if !(0.0..=1.0).contains(&roughness) {
                         return fail(
-                            m.roughness.as_ref().unwrap().span(),
+                            r.span(),
                             field("roughness"),
                             format!("must be in [0, 1] (0 = mirror), got {roughness}"),
                         );
@@ -339,27 +354,52 @@ impl SceneToml {
                 }
             };
             // A field that does not apply is most likely a mistake: say so.
-            for (value, name, applies) in [
+            for (span, name, applies) in [
                 (
-                    &m.roughness,
+                    m.roughness.as_ref().map(|r| r.span()),
                     "roughness",
                     matches!(kind, MaterialKind::Metal { .. }),
                 ),
                 (
-                    &m.ior,
+                    m.ior.as_ref().map(|r| r.span()),
                     "ior",
                     matches!(kind, MaterialKind::Dielectric { .. }),
                 ),
             ] {
-                if let (Some(v), false) = (value, applies) {
+                if let (Some(span), false) = (span, applies) {
                     return fail(
-                        v.span(),
+                        span,
                         field(name),
                         format!("{name} does not apply to a {} material", m.kind.get_ref()),
                     );
                 }
             }
+            let roughness_texture = match &m.roughness {
+                Some(r) => match r.get_ref() {
+                    RoughnessToml::Other(value) => Some(texture(
+                        &S::new(r.span(), value.clone()),
+                        &field("roughness"),
+                        folder,
+                        TextureUse::Roughness,
+                        &mut textures,
+                    )?),
+                    RoughnessToml::Value(_) => None,
+                },
+                None => None,
+            };
+            let color_texture = match &m.color {
+                Some(c) if c.get_ref().is_table() => Some(texture(
+                    c,
+                    &field("color"),
+                    folder,
+                    TextureUse::Color,
+                    &mut textures,
+                )?),
+                _ => None,
+            };
             let color = match (&m.color, kind) {
+                // Textured: the constant is unused.
+                (Some(_), _) if color_texture.is_some() => Vec3::ONE,
                 (Some(c), _) => {
                     let color = non_negative(c, &field("color"))?;
                     if color.max_element() > 1.0 {
@@ -381,10 +421,16 @@ impl SceneToml {
                     );
                 }
             };
-            let emission = match &m.emission {
-                Some(e) => non_negative(e, &field("emission"))?,
-                None => Vec3::ZERO,
-            };
+            let emission =
+                match &m.emission {
+                    Some(e) if e.get_ref().is_table() => return fail(
+                        e.span(),
+                        field("emission"),
+                        "takes no texture: only color (and a metal's roughness) may be textured",
+                    ),
+                    Some(e) => non_negative(e, &field("emission"))?,
+                    None => Vec3::ZERO,
+                };
             let strength = match &m.strength {
                 Some(s) => {
                     let v = real(s, &field("strength"))?;
@@ -411,6 +457,8 @@ impl SceneToml {
                 kind,
                 color,
                 emitted_radiance: emission * strength,
+                color_texture,
+                roughness_texture,
             });
         }
         let material_ref = |m: &S<String>, field: String| -> Result<u32, FieldError> {
@@ -576,7 +624,84 @@ impl SceneToml {
             spheres,
             quads,
             triangles,
+            textures,
         };
         Ok((scene, warnings))
+    }
+}
+
+/// A texture as written in a material field: `{ texture = "file" }` (relative to `folder`) or
+/// `{ checker = [[r, g, b], [r, g, b]], scale = s }` (scale optional, default 1). Returns its
+/// index in `textures`.
+fn texture(
+    x: &S<toml::Value>,
+    field: &str,
+    folder: &Path,
+    usage: TextureUse,
+    textures: &mut TextureSet,
+) -> Result<u32, FieldError> {
+    let expected = "must be a constant, { texture = \"file.png\" } or { checker = [[r, g, b], [r, g, b]], scale = s }";
+    let Some(table) = x.get_ref().as_table() else {
+        return fail(x.span(), field, format!("{expected}, got {}", x.get_ref()));
+    };
+    let keys: Vec<&str> = table.keys().map(|k| k.as_str()).collect();
+    match keys.as_slice() {
+        ["texture"] => {
+            let Some(file) = table["texture"].as_str() else {
+                return fail(x.span(), field, "texture must be a file name (a string)");
+            };
+            textures
+                .image(&folder.join(file), usage)
+                .or_else(|message| fail(x.span(), field, format!("{file}: {message}")))
+        }
+        ["checker"] | ["checker", "scale"] | ["scale", "checker"] => {
+            let colors = match table["checker"].as_array() {
+                Some(c) if c.len() == 2 => c,
+                _ => {
+                    return fail(
+                        x.span(),
+                        field,
+                        "checker must be two colors [[r, g, b], [r, g, b]]",
+                    )
+                }
+            };
+            let mut pair = [Vec3::ZERO; 2];
+            for (out, c) in pair.iter_mut().zip(colors) {
+                let color = vec3(&S::new(x.span(), c.clone()), &format!("{field}.checker"))?;
+                if color.min_element() < 0.0 || color.max_element() > 1.0 {
+                    return fail(
+                        x.span(),
+                        format!("{field}.checker"),
+                        format!("every value must be in [0, 1], got {color}"),
+                    );
+                }
+                *out = color;
+            }
+            let scale = match table.get("scale") {
+                None => 1.0,
+                Some(toml::Value::Float(v)) => *v,
+                Some(toml::Value::Integer(v)) => *v as f64,
+                Some(other) => {
+                    return fail(
+                        x.span(),
+                        format!("{field}.scale"),
+                        format!("must be a number, got {other}"),
+                    )
+                }
+            };
+            if !(scale > 0.0 && scale <= 1e6) {
+                return fail(
+                    x.span(),
+                    format!("{field}.scale"),
+                    format!("must be in (0, 1e6] squares per unit of u and v, got {scale}"),
+                );
+            }
+            Ok(textures.checker(pair, scale as f32))
+        }
+        _ => fail(
+            x.span(),
+            field,
+            format!("{expected}; unknown keys: {}", keys.join(", ")),
+        ),
     }
 }

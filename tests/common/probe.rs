@@ -60,6 +60,9 @@ pub fn run_probe(
     let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
     let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
     let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+    let textures = storage_buffer(ctx, "textures", &scene.textures);
+    let texels = storage_buffer(ctx, "texels", &scene.texels);
+    let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -91,6 +94,9 @@ pub fn run_probe(
             (13, read_only, &bvh_primitives),
             (10, wgpu::BufferBindingType::Uniform, &probe_params),
             (11, read_write, &out),
+            (20, read_only, &textures),
+            (21, read_only, &texels),
+            (22, read_only, &triangle_uvs),
         ],
     );
     let pipeline = compute_pipeline(device, entry, &layout, &module, entry);

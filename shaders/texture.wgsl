@@ -1,0 +1,90 @@
+// Textures (mirror: src/cpu/texture.rs): texture coordinates at a hit, image lookups with
+// bilinear filtering and repeat wrapping, procedural checkers, and the material at a hit.
+//
+// Textures live in storage buffers and are filtered by hand, not by a sampler: a hardware
+// sampler's filtering precision is implementation-defined (weights may be 8-bit fixed point),
+// so it would break "GPU and CPU trace the same paths". Compiled in only when a material uses
+// a texture (HAS_TEXTURES, src/shader.rs).
+
+// Every texture's descriptor, and all images' texels (linear RGB; w unused) one after another.
+@group(0) @binding(20) var<storage, read> textures: array<Texture>;
+@group(0) @binding(21) var<storage, read> texels: array<vec4<f32>>;
+// One per triangle when the scene has textures (a placeholder otherwise).
+@group(0) @binding(22) var<storage, read> triangle_uvs: array<TriangleUvs>;
+
+const TWO_PI_INV: f32 = 0.159154943091895;
+const PI_INV: f32 = 0.318309886183791;
+
+// A sphere's (longitude, latitude) at the unit outward normal n: u = 0.5 + atan2(-z, x) / 2pi
+// (the seam faces -x; u grows counterclockwise seen from +y, so images are not mirrored seen
+// from outside), v = 1 - theta / pi with theta the angle from +y (v = 1 at the top pole).
+fn sphere_uv(n: vec3<f32>) -> vec2<f32> {
+    let u = 0.5 + atan2(-n.z, n.x) * TWO_PI_INV;
+    let v = 1.0 - acos(clamp(n.y, -1.0, 1.0)) * PI_INV;
+    return vec2<f32>(u, v);
+}
+
+// Interpolated vertex texture coordinates at barycentrics b (b.x for uv0).
+fn triangle_uv(index: u32, b: vec3<f32>) -> vec2<f32> {
+    let t = triangle_uvs[index];
+    return b.x * t.uv0 + b.y * t.uv1 + b.z * t.uv2;
+}
+
+// Texel (x, y) of an image, counted from its bottom-left corner.
+fn texel(t: Texture, x: u32, y: u32) -> vec3<f32> {
+    return texels[t.first_texel + y * t.width + x].xyz;
+}
+
+// The column or row below a sample position and the one after it, wrapped (repeat): positions
+// in [-0.5, 0) blend the last and the first texel.
+fn wrapped_pair(position_floor: f32, size: u32) -> vec2<u32> {
+    let first = select(min(u32(position_floor), size - 1u), size - 1u, position_floor < 0.0);
+    let second = select(first + 1u, 0u, first + 1u >= size);
+    return vec2<u32>(first, second);
+}
+
+// Bilinear filtering with repeat wrapping; texel centres are at ((x + 0.5) / width,
+// (y + 0.5) / height), where the lookup returns the texel itself.
+fn image_lookup(t: Texture, uv: vec2<f32>) -> vec3<f32> {
+    let x = (uv.x - floor(uv.x)) * f32(t.width) - 0.5;
+    let y = (uv.y - floor(uv.y)) * f32(t.height) - 0.5;
+    let x_floor = floor(x);
+    let y_floor = floor(y);
+    let fx = x - x_floor;
+    let fy = y - y_floor;
+    let xs = wrapped_pair(x_floor, t.width);
+    let ys = wrapped_pair(y_floor, t.height);
+    let bottom = texel(t, xs.x, ys.x) * (1.0 - fx) + texel(t, xs.y, ys.x) * fx;
+    let top = texel(t, xs.x, ys.y) * (1.0 - fx) + texel(t, xs.y, ys.y) * fx;
+    return bottom * (1.0 - fy) + top * fy;
+}
+
+// color0 where floor(u scale) + floor(v scale) is even, color1 where it is odd (unfiltered).
+fn checker_lookup(t: Texture, uv: vec2<f32>) -> vec3<f32> {
+    let half_sum = (floor(uv.x * t.scale) + floor(uv.y * t.scale)) * 0.5;
+    return select(t.color0, t.color1, half_sum != floor(half_sum));
+}
+
+fn texture_lookup(index: u32, uv: vec2<f32>) -> vec3<f32> {
+    let t = textures[index];
+    if t.kind == TEXTURE_CHECKER {
+        return checker_lookup(t, uv);
+    }
+    return image_lookup(t, uv);
+}
+
+// The material at a hit with texture coordinates uv: textured colour and roughness replace
+// the constant ones, before any BSDF or AOV reads them.
+fn material_at(m: Material, uv: vec2<f32>) -> Material {
+    var out = m;
+    if HAS_TEXTURES {
+        if m.color_texture != NO_TEXTURE {
+            out.albedo = texture_lookup(m.color_texture, uv);
+        }
+        if m.roughness_texture != NO_TEXTURE {
+            let roughness = texture_lookup(m.roughness_texture, uv).x;
+            out.alpha = roughness * roughness;
+        }
+    }
+    return out;
+}
