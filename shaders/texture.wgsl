@@ -12,15 +12,30 @@
 // One per triangle when the scene has textures (a placeholder otherwise).
 @group(0) @binding(22) var<storage, read> triangle_uvs: array<TriangleUvs>;
 
-const TWO_PI_INV: f32 = 0.159154943091895;
 const PI_INV: f32 = 0.318309886183791;
+
+// atan2(y, x) in (-pi, pi] from a polynomial (Abramowitz and Stegun 4.4.49, |error| <= 2e-8
+// rad, below an f32 ulp of pi): Vulkan lets atan and acos be off by 4096 ulps, which would make
+// the GPU's texture coordinates, and colours, differ from the CPU's.
+fn polynomial_atan2(y: f32, x: f32) -> f32 {
+    let ax = abs(x);
+    let ay = abs(y);
+    let big = max(ax, ay);
+    let t = select(min(ax, ay) / big, 0.0, big == 0.0);
+    let t2 = t * t;
+    var r = (((((((-0.0040540580 * t2 + 0.0218612288) * t2 - 0.0559098861) * t2 + 0.0964200441)
+        * t2 - 0.1390853351) * t2 + 0.1994653599) * t2 - 0.3332985605) * t2 + 0.9999993329) * t;
+    r = select(r, 1.57079632679490 - r, ay > ax);
+    r = select(r, 3.14159265358979 - r, x < 0.0);
+    return select(r, -r, y < 0.0);
+}
 
 // A sphere's (longitude, latitude) at the unit outward normal n: u = 0.5 + atan2(-z, x) / 2pi
 // (the seam faces -x; u grows counterclockwise seen from +y, so images are not mirrored seen
-// from outside), v = 1 - theta / pi with theta the angle from +y (v = 1 at the top pole).
+// from outside), v = 0.5 + latitude / pi (v = 1 at the top pole, +y; 0 at the bottom one).
 fn sphere_uv(n: vec3<f32>) -> vec2<f32> {
-    let u = 0.5 + atan2(-n.z, n.x) * TWO_PI_INV;
-    let v = 1.0 - acos(clamp(n.y, -1.0, 1.0)) * PI_INV;
+    let u = 0.5 + polynomial_atan2(-n.z, n.x) * (0.5 * PI_INV);
+    let v = 0.5 + polynomial_atan2(n.y, sqrt(n.x * n.x + n.z * n.z)) * PI_INV;
     return vec2<f32>(u, v);
 }
 

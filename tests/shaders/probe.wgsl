@@ -103,3 +103,15 @@ fn probe_watertight(@builtin(global_invocation_id) id: vec3<u32>) {
     let origin = probe.position + probe.alpha * jitter;
     probe_out[id.x] = vec4<f32>(closest_primitive(Ray(origin, normalize(aim - origin))).t, 0.0, 0.0, 0.0);
 }
+
+// Texture lookups: texture probe.seed of the bound scene at the texture coordinates held, one
+// per entry, in the scene's triangle_uvs[id].uv0 (tests/textures.rs fills them); writes the
+// value in xyz.
+@compute @workgroup_size(256, 1, 1)
+fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    let uv = triangle_uv(id.x, vec3<f32>(1.0, 0.0, 0.0));
+    probe_out[id.x] = vec4<f32>(texture_lookup(probe.seed, uv), 0.0);
+}
