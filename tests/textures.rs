@@ -513,3 +513,60 @@ fn sphere_coordinates() {
     assert!(close(sphere_uv(Vec3::Y), Vec2::new(0.5, 1.0)));
     assert!(close(sphere_uv(Vec3::NEG_Y), Vec2::new(0.5, 0.0)));
 }
+
+/// An OBJ's `vt` coordinates reach the triangles and its `.mtl`'s `map_Kd` becomes the colour
+/// texture of the file's material; the textured mesh under a white sky renders the texture's
+/// colours on both devices (a 1-bounce diffuse surface there shows exactly its albedo).
+#[test]
+fn obj_texture_coordinates_and_map_kd() {
+    let dir = tempfile::tempdir().unwrap();
+    // Two texels: red on the left (u < 0.5), blue on the right.
+    write_png(&dir.path().join("rb.png"), 2, 1, |x, _| {
+        if x == 0 {
+            [255, 0, 0]
+        } else {
+            [0, 0, 255]
+        }
+    });
+    let obj = "mtllib q.mtl\nv 1 -1 0\nv -1 -1 0\nv -1 1 0\nv 1 1 0\n\
+               vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl painted\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
+    std::fs::write(dir.path().join("q.obj"), obj).unwrap();
+    std::fs::write(
+        dir.path().join("q.mtl"),
+        "newmtl painted\nKd 1 1 1\nmap_Kd rb.png\n",
+    )
+    .unwrap();
+    let text = std::fs::read_to_string({
+        scene_with(dir.path(), "type = \"diffuse\"\ncolor = [1, 1, 1]", 16).unwrap();
+        dir.path().join("scene.toml")
+    })
+    .unwrap()
+    .replace("[[quads]]", "[[meshes]]\nfile = \"q.obj\"\n[[unused]]");
+    // Keep only the mesh: drop the quad's lines after the marker.
+    let text = text[..text.find("[[unused]]").unwrap()].to_string();
+    std::fs::write(dir.path().join("scene.toml"), text).unwrap();
+    let scene = Scene::load(&dir.path().join("scene.toml")).unwrap();
+    let painted = scene
+        .materials
+        .iter()
+        .find(|m| m.name == "q.obj/painted")
+        .unwrap();
+    assert!(painted.color_texture.is_some());
+    let scene = scene.kernel_scene();
+    assert_eq!(scene.triangle_uvs.len(), 2);
+    assert_eq!(scene.triangle_uvs[0].uv1, [1.0, 0.0]);
+    assert_eq!(scene.triangle_uvs[1].uv2, [0.0, 1.0]);
+    for (device, image) in common::render_both(&scene, 1) {
+        // Pixel columns 3 and 12 are at u ≈ 0.22 and 0.78, within a quarter texel of the
+        // texels' centres: mostly red, mostly blue.
+        for py in [2, 8, 13] {
+            let left = Vec3::from(image.pixels[py * 16 + 3]);
+            let right = Vec3::from(image.pixels[py * 16 + 12]);
+            assert!(
+                left.x > 0.7 && left.z < 0.3 && left.y == 0.0,
+                "{device}: {left}"
+            );
+            assert!(right.z > 0.7 && right.x < 0.3, "{device}: {right}");
+        }
+    }
+}

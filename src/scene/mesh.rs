@@ -3,11 +3,12 @@
 //! table). Everything is checked here, before rendering: unreadable or malformed files, vertices
 //! that are not finite, indices out of range, meshes left with no triangles.
 
+use super::texture::{TextureSet, TextureUse};
 use super::{Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::io::{BufRead, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
 /// fit any GPU's storage binding anyway.
@@ -50,8 +51,10 @@ pub(super) struct MeshPart {
 pub(super) struct MeshFile {
     parts: Vec<MeshPart>,
     materials: Vec<Material>,
-    /// Whether any material refers to a texture (ignored until textures are supported).
-    has_textures: bool,
+    /// Per material: its colour texture's file (OBJ `map_Kd`, glTF `baseColorTexture` by URI).
+    color_textures: Vec<Option<PathBuf>>,
+    /// Whether any material refers to a texture glint does not use (normal maps, ...).
+    has_other_textures: bool,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -70,6 +73,7 @@ pub(super) fn load(
     material: Option<u32>,
     smooth: bool,
     scene_materials: &mut Vec<Material>,
+    textures: &mut TextureSet,
 ) -> Result<LoadedMesh, String> {
     let extension = path
         .extension()
@@ -95,9 +99,9 @@ pub(super) fn load(
     }
     .map_err(|e| format!("{shown}: {e}"))?;
     let mut warnings = Vec::new();
-    if file.has_textures {
+    if file.has_other_textures {
         warnings.push(format!(
-            "{shown}: texture maps are ignored (glint has no textures yet); the materials' constant factors are used"
+            "{shown}: texture maps other than the base colour (normal, roughness, emission, ...) are ignored"
         ));
     }
     // The file's materials become scene materials, but only when they are used.
@@ -143,6 +147,17 @@ pub(super) fn load(
                     Some(m) => m,
                     None => {
                         let mut m = file.materials[index].clone();
+                        if let Some(texture) = &file.color_textures[index] {
+                            let index =
+                                textures.image(texture, TextureUse::Color).map_err(|e| {
+                                    format!(
+                                        "material {:?}: texture {}: {e}",
+                                        m.name,
+                                        texture.display()
+                                    )
+                                })?;
+                            m.color_texture = Some(index);
+                        }
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;
                         scene_materials.push(m);
@@ -281,6 +296,7 @@ fn check_emission(name: &str, what: &str, e: Vec3) -> Result<Vec3, String> {
 /// OBJ `.mtl`: Kd → diffuse colour, Ke → emission, d < 1 → dielectric with Ni (default 1.5),
 /// illum 3 or 5 → mirror with Ks (else Kd).
 fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
+    // map_Kd is used (see read_obj); the other maps are not.
     let name = &m.name;
     let kd = Vec3::from(m.diffuse.unwrap_or([0.8; 3]));
     let emission = check_emission(name, "Ke", Vec3::from(m.emissive.unwrap_or([0.0; 3])))?;
@@ -301,7 +317,6 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
     };
     let textures = [
         &m.ambient_texture,
-        &m.diffuse_texture,
         &m.specular_texture,
         &m.normal_texture,
         &m.shininess_texture,
@@ -352,11 +367,14 @@ fn read_obj(path: &Path) -> Result<MeshFile, String> {
     .map_err(|e| format!("line {}: malformed OBJ: {e}", reader.lines.max(1)))?;
     // A missing or broken .mtl leaves the faces without materials; a face that needs one says so.
     let materials = materials.unwrap_or_default();
-    let mut has_textures = false;
+    let mut has_other_textures = false;
     let mut converted = Vec::new();
+    let mut color_textures = Vec::new();
     for m in &materials {
+        // Relative to the OBJ's folder, as tobj reads the .mtl from there.
+        color_textures.push(m.diffuse_texture.as_ref().map(|t| dir.join(t.trim())));
         let (m, textures) = obj_material(m)?;
-        has_textures |= textures;
+        has_other_textures |= textures;
         converted.push(m);
     }
     let parts = models
@@ -384,7 +402,8 @@ fn read_obj(path: &Path) -> Result<MeshFile, String> {
     Ok(MeshFile {
         parts,
         materials: converted,
-        has_textures,
+        color_textures,
+        has_other_textures,
     })
 }
 
@@ -479,7 +498,8 @@ fn read_ply(path: &Path) -> Result<MeshFile, String> {
             name: String::new(),
         }],
         materials: Vec::new(),
-        has_textures: false,
+        color_textures: Vec::new(),
+        has_other_textures: false,
     })
 }
 
@@ -511,8 +531,7 @@ fn gltf_material(m: &gltf::Material, index: usize) -> Result<(Material, bool), S
         "emissiveFactor × emissive strength",
         Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
     )?;
-    let textures = pbr.base_color_texture().is_some()
-        || pbr.metallic_roughness_texture().is_some()
+    let textures = pbr.metallic_roughness_texture().is_some()
         || m.normal_texture().is_some()
         || m.occlusion_texture().is_some()
         || m.emissive_texture().is_some();
@@ -536,10 +555,26 @@ fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     let buffers = gltf::import_buffers(&gltf.document, path.parent(), gltf.blob.clone())
         .map_err(|e| format!("glTF buffers: {e}"))?;
     let mut materials = Vec::new();
-    let mut has_textures = false;
+    let mut color_textures = Vec::new();
+    let mut has_other_textures = false;
     for (i, m) in gltf.document.materials().enumerate() {
+        let base = m.pbr_metallic_roughness().base_color_texture();
+        // Images referred to by URI, relative to the glTF file, on texture coordinate set 0;
+        // embedded images (buffer views, data URIs) and other sets are not read.
+        let file = base
+            .as_ref()
+            .and_then(|info| match info.texture().source().source() {
+                gltf::image::Source::Uri { uri, .. }
+                    if info.tex_coord() == 0 && !uri.starts_with("data:") =>
+                {
+                    Some(path.parent().unwrap_or(Path::new("")).join(uri))
+                }
+                _ => None,
+            });
+        has_other_textures |= base.is_some() && file.is_none();
+        color_textures.push(file);
         let (m, textures) = gltf_material(&m, i)?;
-        has_textures |= textures;
+        has_other_textures |= textures;
         materials.push(m);
     }
     let mut parts = Vec::new();
@@ -596,6 +631,7 @@ fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     Ok(MeshFile {
         parts,
         materials,
-        has_textures,
+        color_textures,
+        has_other_textures,
     })
 }

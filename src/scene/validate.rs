@@ -585,6 +585,7 @@ impl SceneToml {
                 material,
                 m.smooth.unwrap_or(true),
                 &mut materials,
+                &mut textures,
             )
             .or_else(|message| fail(m.file.span(), field("file"), message))?;
             warnings.extend(loaded.warnings);
