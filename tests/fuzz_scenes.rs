@@ -113,7 +113,8 @@ fn shipped_scenes() -> Vec<(String, String)> {
         // Mesh scenes name files relative to their folder (and stress.toml one that is
         // generated), so a mutant parsed from text alone could never be valid, and loading a
         // mesh per case would cost seconds: tests/mesh_errors.rs covers bad meshes instead.
-        .filter(|(_, text)| !text.contains("[[meshes]]"))
+        // Image textures are files too (tests/textures.rs covers bad ones).
+        .filter(|(_, text)| !text.contains("[[meshes]]") && !text.contains("texture ="))
         .collect();
     scenes.sort();
     assert!(scenes.len() >= 5, "the shipped scenes are missing");

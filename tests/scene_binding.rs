@@ -140,6 +140,10 @@ fn compiled_out_features_do_not_change_the_image() {
         ("materials", materials_scene(32, 5)),
         ("quad and sphere emitters", lit_by_both),
         ("sphere emitter only", common::floor_under_lamp(32, 2, 3)),
+        (
+            "textured",
+            sized(shipped_scene("cornell-textured.toml"), 32, 4),
+        ),
     ];
     let mut variants_seen = Vec::new();
     for (name, scene) in scenes {
@@ -170,9 +174,10 @@ fn compiled_out_features_do_not_change_the_image() {
             f.quad_emitters,
             f.metal,
             f.dielectric,
+            f.textures,
         ]
     };
-    for i in 0..5 {
+    for i in 0..6 {
         assert!(
             variants_seen.iter().any(|f| flags(f)[i]),
             "flag {i} never on"

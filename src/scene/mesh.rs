@@ -371,11 +371,14 @@ fn read_obj(path: &Path) -> Result<MeshFile, String> {
     let mut converted = Vec::new();
     let mut color_textures = Vec::new();
     for m in &materials {
-        // Relative to the OBJ's folder, as tobj reads the .mtl from there.
-        color_textures.push(m.diffuse_texture.as_ref().map(|t| dir.join(t.trim())));
-        let (m, textures) = obj_material(m)?;
-        has_other_textures |= textures;
-        converted.push(m);
+        let (material, textures) = obj_material(m)?;
+        // map_Kd is the diffuse colour: mirrors (Ks) and glass (clear) do not use it. Relative
+        // to the OBJ's folder, as tobj reads the .mtl from there.
+        let map_kd = m.diffuse_texture.as_ref().map(|t| dir.join(t.trim()));
+        let diffuse = material.kind == MaterialKind::Diffuse;
+        has_other_textures |= textures || (map_kd.is_some() && !diffuse);
+        color_textures.push(map_kd.filter(|_| diffuse));
+        converted.push(material);
     }
     let parts = models
         .into_iter()
