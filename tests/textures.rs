@@ -570,3 +570,53 @@ fn obj_texture_coordinates_and_map_kd() {
         }
     }
 }
+
+/// A glTF's TEXCOORD_0 reaches the triangles with v flipped (glTF's v points down, glint's
+/// up), and its material's baseColorTexture, an image by URI, becomes the colour texture.
+#[test]
+fn gltf_texcoords_and_base_color_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("t.png"), 2, 2, distinct);
+    let positions: [f32; 9] = [1.0, -1.0, 0.0, -1.0, -1.0, 0.0, -1.0, 1.0, 0.0];
+    let texcoords: [f32; 6] = [0.0, 1.0, 1.0, 1.0, 1.0, 0.25];
+    let mut buffer: Vec<u8> = bytemuck::cast_slice(&positions).to_vec();
+    buffer.extend_from_slice(bytemuck::cast_slice(&texcoords));
+    std::fs::write(dir.path().join("buf.bin"), &buffer).unwrap();
+    let gltf = r#"{
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0]}],
+  "nodes": [{"mesh": 0}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0.0}}],
+  "textures": [{"source": 0}],
+  "images": [{"uri": "t.png"}],
+  "buffers": [{"uri": "buf.bin", "byteLength": 60}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+  "accessors": [
+    {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+    {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}
+  ]
+}"#;
+    std::fs::write(dir.path().join("t.gltf"), gltf).unwrap();
+    scene_with(dir.path(), "type = \"diffuse\"\ncolor = [1, 1, 1]", 4).unwrap();
+    let path = dir.path().join("scene.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let text =
+        text[..text.find("[[quads]]").unwrap()].to_string() + "[[meshes]]\nfile = \"t.gltf\"\n";
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let material = scene
+        .materials
+        .iter()
+        .find(|m| m.name.starts_with("t.gltf/"))
+        .unwrap();
+    assert!(material.color_texture.is_some());
+    let scene = scene.kernel_scene();
+    assert_eq!(scene.texels.len(), 4);
+    let uvs = scene.triangle_uvs[0];
+    assert_eq!(
+        [uvs.uv0, uvs.uv1, uvs.uv2],
+        [[0.0, 0.0], [1.0, 0.0], [1.0, 0.75]]
+    );
+}
