@@ -97,7 +97,7 @@ struct App {
     /// The accumulation restarted: the next frame is a 1-spp preview.
     restarted: bool,
     /// The tone curve and the exposure (which + and - change).
-    display: crate::tonemap::DisplayTransform,
+    display: DisplayTransform,
     /// The kernel accumulates the denoiser's AOVs: from the first D on (turning them off again
     /// would compile another kernel and restart for nothing).
     aovs: bool,
