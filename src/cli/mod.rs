@@ -8,6 +8,7 @@ mod render;
 mod render_writer;
 mod sample_range;
 mod stress_mesh;
+mod tone;
 mod view;
 
 use crate::error::InputError;
