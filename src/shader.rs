@@ -8,7 +8,7 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 13] = [
+pub const SHADER_PARTS: [(&str, &str); 14] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -17,6 +17,10 @@ pub const SHADER_PARTS: [(&str, &str); 13] = [
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
+    (
+        "environment.wgsl",
+        include_str!("../shaders/environment.wgsl"),
+    ),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
     (
@@ -153,6 +157,9 @@ pub struct KernelFeatures {
     pub dielectric: bool,
     /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/aov.wgsl).
     pub aovs: bool,
+    /// An environment map (`[environment]`, shaders/environment.wgsl) in place of the
+    /// constant background, and light sampling of it when that is on.
+    pub environment: bool,
 }
 
 impl KernelFeatures {
@@ -165,6 +172,7 @@ impl KernelFeatures {
         metal: true,
         dielectric: true,
         aovs: true,
+        environment: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -179,6 +187,7 @@ impl KernelFeatures {
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
             aovs: scene.params.aovs != 0,
+            environment: scene.params.environment_width > 0,
         }
     }
 
@@ -192,6 +201,7 @@ impl KernelFeatures {
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
             && needs(self.aovs, other.aovs)
+            && needs(self.environment, other.environment)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -199,14 +209,16 @@ impl KernelFeatures {
         format!(
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
-             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n",
+             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n\
+             const HAS_ENVIRONMENT: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
             self.triangle_emitters,
             self.metal,
             self.dielectric,
-            self.aovs
+            self.aovs,
+            self.environment
         )
     }
 }

@@ -60,6 +60,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             material: 0,
         }],
         triangles: vec![],
+        environment: None,
     };
     scene.kernel_scene().quads[0]
 }

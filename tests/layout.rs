@@ -6,7 +6,8 @@ use glint::shader::{
     SceneCounts, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use glint::shader_types::{
-    BvhNode, Emitter, Material, Params, Quad, Sphere, Triangle, TriangleNormals,
+    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Material, Params, Quad, Sphere, Triangle,
+    TriangleNormals,
 };
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
@@ -105,8 +106,12 @@ fn rust_structs_match_wgsl_layout() {
             aovs,
             radiance_clamp,
             triangle_count,
-            pad2,
-            pad3
+            environment_width,
+            environment_height,
+            environment_cos,
+            environment_sin,
+            environment_light_probability,
+            pad4
         ]
     );
     assert_same_layout!(
@@ -159,6 +164,18 @@ fn rust_structs_match_wgsl_layout() {
         [n0, smooth_shading, n1, n2]
     );
     assert_same_layout!(&module, BvhNode, "BvhNode", [min, first, max, count]);
+    assert_same_layout!(
+        &module,
+        EnvironmentTexel,
+        "EnvironmentTexel",
+        [radiance, pdf]
+    );
+    assert_same_layout!(
+        &module,
+        EnvironmentAlias,
+        "EnvironmentAlias",
+        [threshold, alias_texel]
+    );
 }
 
 #[test]
@@ -262,7 +279,7 @@ fn every_feature_combination_validates() {
         materials: 5,
         emitters: 1,
     };
-    for bits in 0..128u32 {
+    for bits in 0..256u32 {
         let features = KernelFeatures {
             light_sampling: bits & 1 != 0,
             sphere_emitters: bits & 2 != 0,
@@ -271,6 +288,7 @@ fn every_feature_combination_validates() {
             dielectric: bits & 16 != 0,
             aovs: bits & 32 != 0,
             triangle_emitters: bits & 64 != 0,
+            environment: bits & 128 != 0,
         };
         for binding in [
             SceneBinding::Storage,

@@ -184,6 +184,16 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.bvh_primitives),
                     read_only,
                 ),
+                BufferNeed::new(
+                    "environment map",
+                    array_bytes(&scene.environment_texels),
+                    read_only,
+                ),
+                BufferNeed::new(
+                    "environment alias table",
+                    array_bytes(&scene.environment_alias),
+                    read_only,
+                ),
                 BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
@@ -204,6 +214,9 @@ impl<'a> GpuRenderer<'a> {
         let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
         let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+        let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
+        let environment_alias =
+            storage_buffer(ctx, "environment alias table", &scene.environment_alias);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -260,6 +273,8 @@ impl<'a> GpuRenderer<'a> {
                 (11, read_write, &aov_buffers[1]),
                 (16, read_write, &nonfinite_buffer),
                 (17, wgpu::BufferBindingType::Uniform, &tile_buffer),
+                (18, read_only, &environment_texels),
+                (19, read_only, &environment_alias),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

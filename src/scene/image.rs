@@ -51,7 +51,10 @@ pub fn srgb_to_linear(encoded: f32) -> f32 {
 
 /// Whether the format stores linear floats (EXR, HDR) rather than encoded integers.
 fn is_float_format(format: image::ImageFormat) -> bool {
-    matches!(format, image::ImageFormat::OpenExr | image::ImageFormat::Hdr)
+    matches!(
+        format,
+        image::ImageFormat::OpenExr | image::ImageFormat::Hdr
+    )
 }
 
 /// Reads and decodes `path` (PNG, JPEG, EXR or Radiance HDR, told apart by content). The
@@ -80,7 +83,9 @@ pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage,
         .into_dimensions()
         .map_err(|e| format!("cannot decode the image: {e}"))?;
     if width == 0 || height == 0 {
-        return Err(format!("the image is {width}×{height}; it must have texels"));
+        return Err(format!(
+            "the image is {width}×{height}; it must have texels"
+        ));
     }
     let texel_count = width as u64 * height as u64;
     if texel_count > MAX_IMAGE_TEXELS {

@@ -2,13 +2,15 @@
 //! that light sampling draws from.
 
 use super::bvh;
+use super::environment;
 use super::{CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
-    self, BvhNode, Emitter, Params, TriangleNormals, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
-    MATERIAL_METAL, MATERIAL_SPECULAR, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
-    ROULETTE_OFF,
+    self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, TriangleNormals,
+    MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_SPECULAR,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
+use glam::Vec3;
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
 #[derive(Clone, Debug)]
@@ -26,6 +28,9 @@ pub struct KernelScene {
     pub bvh_nodes: Vec<BvhNode>,
     pub bvh_primitives: Vec<u32>,
     pub bvh_build_seconds: f64,
+    /// The environment map's texels and alias table (`environment.rs`); empty without one.
+    pub environment_texels: Vec<EnvironmentTexel>,
+    pub environment_alias: Vec<EnvironmentAlias>,
 }
 
 impl KernelScene {
@@ -42,6 +47,8 @@ impl KernelScene {
             + bytes(&self.triangle_normals)
             + bytes(&self.bvh_nodes)
             + bytes(&self.bvh_primitives)
+            + bytes(&self.environment_texels)
+            + bytes(&self.environment_alias)
     }
 }
 
@@ -65,12 +72,16 @@ impl Scene {
         let half_height = (c.vfov.to_radians() * 0.5).tan();
         let half_width = half_height * r.width as f32 / r.height as f32;
         let lens_radius = 0.5 * c.aperture;
+        let environment = self.environment.as_ref().map(|e| (e, e.tables()));
         let (
             emitters,
             sphere_light_probability,
             quad_light_probability,
             triangle_light_probability,
-        ) = self.emitter_table();
+        ) = self.emitter_table(environment.as_ref().map(|(_, t)| t.radiance_integral));
+        let (environment_cos, environment_sin) = environment
+            .as_ref()
+            .map_or((1.0, 0.0), |(e, _)| e.rotation());
         let params = Params {
             eye: c.eye.into(),
             width: r.width,
@@ -100,8 +111,15 @@ impl Scene {
             aovs: 0,
             radiance_clamp: 0.0,
             triangle_count: self.triangles.len() as u32,
-            pad2: 0,
-            pad3: 0,
+            environment_width: environment.as_ref().map_or(0, |(e, _)| e.image.width),
+            environment_height: environment.as_ref().map_or(0, |(e, _)| e.image.height),
+            environment_cos,
+            environment_sin,
+            environment_light_probability: emitters
+                .iter()
+                .find(|e| e.primitive == PRIMITIVE_ENVIRONMENT)
+                .map_or(0.0, |e| e.probability),
+            pad4: 0,
         };
         let spheres = self
             .spheres
@@ -200,7 +218,13 @@ impl Scene {
             bvh_nodes: Vec::new(),
             bvh_primitives: Vec::new(),
             bvh_build_seconds: 0.0,
+            environment_texels: Vec::new(),
+            environment_alias: Vec::new(),
         };
+        if let Some((_, tables)) = environment {
+            scene.environment_texels = tables.texels;
+            scene.environment_alias = tables.alias;
+        }
         if bvh::wants_bvh(
             scene.spheres.len(),
             scene.quads.len(),
@@ -219,9 +243,14 @@ impl Scene {
 
     /// Every emitting primitive with its selection probability, proportional to its power
     /// (mean emitted radiance × area; the factor π is common to all), and that probability per
-    /// sphere, per quad and per triangle (0 for those that do not emit).
+    /// sphere, per quad and per triangle (0 for those that do not emit). The environment map,
+    /// given its ∫ L dω, emits that through a disc the size of the scene: π R² ∫ L dω, whose π
+    /// is dropped as for the others (pbrt's ImageInfiniteLight::Phi).
     #[allow(clippy::type_complexity)]
-    fn emitter_table(&self) -> (Vec<Emitter>, Vec<f32>, Vec<f32>, Vec<f32>) {
+    fn emitter_table(
+        &self,
+        environment_radiance_integral: Option<f64>,
+    ) -> (Vec<Emitter>, Vec<f32>, Vec<f32>, Vec<f32>) {
         let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
         let mut powers: Vec<(u32, u32, f64)> = Vec::new();
         for (i, s) in self.spheres.iter().enumerate() {
@@ -249,6 +278,30 @@ impl Scene {
                 powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }
         }
+        if let Some(integral) = environment_radiance_integral {
+            let points = self
+                .spheres
+                .iter()
+                .flat_map(|s| {
+                    [
+                        s.center - Vec3::splat(s.radius),
+                        s.center + Vec3::splat(s.radius),
+                    ]
+                })
+                .chain(self.quads.iter().flat_map(|q| {
+                    [
+                        q.corner,
+                        q.corner + q.u,
+                        q.corner + q.v,
+                        q.corner + q.u + q.v,
+                    ]
+                }))
+                .chain(self.triangles.iter().flat_map(|t| t.vertices));
+            let power = environment::scene_radius(points).powi(2) * integral;
+            if power > 0.0 {
+                powers.push((PRIMITIVE_ENVIRONMENT, 0, power));
+            }
+        }
         let total: f64 = powers.iter().map(|p| p.2).sum();
         let mut cumulative = 0.0;
         let mut emitters: Vec<Emitter> = powers
@@ -273,7 +326,8 @@ impl Scene {
             let per_primitive = match e.primitive {
                 PRIMITIVE_SPHERE => &mut sphere_probability,
                 PRIMITIVE_QUAD => &mut quad_probability,
-                _ => &mut triangle_probability,
+                PRIMITIVE_TRIANGLE => &mut triangle_probability,
+                _ => continue,
             };
             per_primitive[e.index as usize] = e.probability;
         }

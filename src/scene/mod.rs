@@ -8,6 +8,7 @@
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
 pub mod bvh;
+pub mod environment;
 mod file;
 pub mod image;
 mod kernel;
@@ -74,6 +75,8 @@ pub struct Scene {
     pub quads: Vec<Quad>,
     /// Every mesh's triangles, in the scene's coordinates.
     pub triangles: Vec<Triangle>,
+    /// `[environment]`: lights the scene in place of `render.background`.
+    pub environment: Option<environment::Environment>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -60,6 +60,8 @@ pub fn run_probe(
     let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
     let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
     let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+    let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
+    let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -91,6 +93,8 @@ pub fn run_probe(
             (13, read_only, &bvh_primitives),
             (10, wgpu::BufferBindingType::Uniform, &probe_params),
             (11, read_write, &out),
+            (18, read_only, &environment_texels),
+            (19, read_only, &environment_alias),
         ],
     );
     let pipeline = compute_pipeline(device, entry, &layout, &module, entry);
