@@ -284,7 +284,7 @@ fn a_rotated_map_equals_a_rotated_camera() {
 }
 
 /// The GPU kernel and the CPU mirror trace the same paths under a map with a sun (the shipped
-/// scenes/sun.toml: sampling of the map, MIS on escape, glass and metal), seed by seed.
+/// scenes/sun.toml: sampling of the map, MIS on escape), seed by seed.
 #[test]
 fn gpu_and_cpu_trace_the_same_paths_under_a_map() {
     let Some(ctx) = common::gpu() else { return };
