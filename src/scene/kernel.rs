@@ -3,7 +3,7 @@
 
 use super::bvh;
 use super::environment;
-use super::{CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
+use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, TriangleNormals,
@@ -52,9 +52,31 @@ impl KernelScene {
     }
 }
 
+/// Writes `camera` into `params` for its image size (`params.width`, `params.height`): the
+/// basis precomputed, image-right and image-up scaled to half the viewport at unit distance,
+/// and the lens. Apart from the rest so the viewer can move the camera without rebuilding the
+/// scene's arrays (the BVH, the environment map's tables).
+pub fn place_camera(params: &mut Params, camera: &Camera) {
+    let CameraBasis {
+        w,
+        right: u,
+        image_up: v,
+    } = camera.basis();
+    let half_height = (camera.vfov.to_radians() * 0.5).tan();
+    let half_width = half_height * params.width as f32 / params.height as f32;
+    let lens_radius = 0.5 * camera.aperture;
+    params.eye = camera.eye.into();
+    params.forward = (-w).into();
+    params.right = (u * half_width).into();
+    params.up = (v * half_height).into();
+    params.lens_right = (u * lens_radius).into();
+    params.lens_up = (v * lens_radius).into();
+    params.focus_distance = camera.focus_distance;
+}
+
 impl Scene {
     /// [`Scene::try_kernel_scene`] for scenes known to fit the kernel (tests, the built-in
-    /// benchmark scene, the viewer); panics where that one returns an error.
+    /// benchmark scene); panics where that one returns an error.
     pub fn kernel_scene(&self) -> KernelScene {
         self.try_kernel_scene().unwrap_or_else(|e| panic!("{e}"))
     }
@@ -62,16 +84,7 @@ impl Scene {
     /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission ×
     /// strength, the BVH). Fails (bad input) when the BVH is deeper than the traversal stack.
     pub fn try_kernel_scene(&self) -> Result<KernelScene, InputError> {
-        let c = &self.camera;
         let r = &self.render;
-        let CameraBasis {
-            w,
-            right: u,
-            image_up: v,
-        } = c.basis();
-        let half_height = (c.vfov.to_radians() * 0.5).tan();
-        let half_width = half_height * r.width as f32 / r.height as f32;
-        let lens_radius = 0.5 * c.aperture;
         let environment = self.environment.as_ref().map(|e| (e, e.tables()));
         let (
             emitters,
@@ -82,20 +95,13 @@ impl Scene {
         let (environment_cos, environment_sin) = environment
             .as_ref()
             .map_or((1.0, 0.0), |(e, _)| e.rotation());
-        let params = Params {
-            eye: c.eye.into(),
+        let mut params = Params {
             width: r.width,
-            forward: (-w).into(),
             height: r.height,
-            right: (u * half_width).into(),
             sample_start: 0,
-            up: (v * half_height).into(),
             sample_count: 0,
             background: r.background.into(),
             max_bounces: r.max_bounces,
-            lens_right: (u * lens_radius).into(),
-            focus_distance: c.focus_distance,
-            lens_up: (v * lens_radius).into(),
             light_sampling: r.light_sampling as u32,
             seed: r.seed,
             sphere_count: self.spheres.len() as u32,
@@ -120,7 +126,9 @@ impl Scene {
                 .find(|e| e.primitive == PRIMITIVE_ENVIRONMENT)
                 .map_or(0.0, |e| e.probability),
             pad4: 0,
+            ..Default::default()
         };
+        place_camera(&mut params, &self.camera);
         let spheres = self
             .spheres
             .iter()

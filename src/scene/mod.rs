@@ -17,7 +17,7 @@ pub mod mesh;
 pub mod stress;
 mod validate;
 
-pub use kernel::KernelScene;
+pub use kernel::{place_camera, KernelScene};
 
 use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};

@@ -12,8 +12,10 @@ use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::{Image, ImageFormat};
 use crate::render::{BatchSizer, Renderer};
 use crate::scene::{
-    Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS, MAX_SPP,
+    place_camera, Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS,
+    MAX_SPP,
 };
+use crate::shader_types::Params;
 use crate::tonemap::{DisplayTransform, Tonemap};
 use anyhow::{anyhow, Context, Result};
 use serde_json::json;
@@ -33,7 +35,12 @@ const EXPOSURE_LIMIT: f32 = 20.0;
 /// How long the test-only `wait-edit` action waits for the scene file to change.
 const WAIT_FOR_EDIT_LIMIT: Duration = Duration::from_secs(60);
 
-pub fn run(event_loop: EventLoop<()>, scene: Scene, mut options: ViewOptions) -> Result<()> {
+pub fn run(
+    event_loop: EventLoop<()>,
+    scene: Scene,
+    kernel: KernelScene,
+    mut options: ViewOptions,
+) -> Result<()> {
     // Progressive rendering never idles: the image refines while nothing happens.
     event_loop.set_control_flow(ControlFlow::Poll);
     let script = std::mem::take(&mut options.script);
@@ -45,6 +52,7 @@ pub fn run(event_loop: EventLoop<()>, scene: Scene, mut options: ViewOptions) ->
         file_camera: scene.camera.clone(),
         camera: scene.camera.clone(),
         scene,
+        kernel,
         options,
         script,
         camera_moved: false,
@@ -89,6 +97,8 @@ struct App {
     script: Script,
     /// The last scene that loaded, its image size set to the window's.
     scene: Scene,
+    /// `scene` as the kernel reads it, with the camera the file gives (see [`App::params`]).
+    kernel: KernelScene,
     /// The camera the scene file says; a reload adopts the file's camera only if it changed,
     /// so editing a material does not throw away where the user flew to.
     file_camera: Camera,
@@ -186,13 +196,20 @@ impl App {
         (self.scene.render.width, self.scene.render.height)
     }
 
+    /// The kernel's parameters for the current camera, image size and AOVs.
+    fn params(&self) -> Params {
+        let mut params = self.kernel.params;
+        place_camera(&mut params, &self.camera);
+        params.aovs = self.aovs as u32;
+        params
+    }
+
     /// The kernel's view of the current scene and camera.
     fn kernel_scene(&self) -> KernelScene {
-        let mut scene = self.scene.clone();
-        scene.camera = self.camera.clone();
-        let mut kernel_scene = scene.kernel_scene();
-        kernel_scene.params.aovs = self.aovs as u32;
-        kernel_scene
+        KernelScene {
+            params: self.params(),
+            ..self.kernel.clone()
+        }
     }
 
     /// Turns denoising on or off (D); without OIDN, says why once and shows the raw image.
@@ -428,7 +445,12 @@ impl App {
                     height: Some(height),
                     ..Default::default()
                 })
-                .map_err(|m| (format!("{}: {m}", path.display()), String::new())),
+                .map_err(|m| format!("{}: {m}", path.display()))
+                .and_then(|scene| {
+                    let kernel = scene.try_kernel_scene().map_err(|e| e.to_string())?;
+                    Ok((scene, kernel))
+                })
+                .map_err(|message| (message, String::new())),
             Err(e) => {
                 let at = e
                     .position
@@ -446,12 +468,13 @@ impl App {
                 self.scene_error = Some(format!("scene error{at}, see stderr"));
                 self.title.since -= TITLE_INTERVAL;
             }
-            Ok(scene) => {
+            Ok((scene, kernel)) => {
                 if scene.camera != self.file_camera {
                     self.file_camera = scene.camera.clone();
                     self.camera = scene.camera.clone();
                 }
                 self.scene = scene;
+                self.kernel = kernel;
                 self.rebuild_renderer()?;
                 if self.scene_error.take().is_some() {
                     crate::errln!("glint: {} reloaded", path.display());
@@ -532,6 +555,9 @@ impl App {
                 ..Default::default()
             })
             .map_err(|m| anyhow!("cannot render at {width}×{height}: {m}"))?;
+        // Only the image size changed: the camera's parameters follow it in params().
+        self.kernel.params.width = width;
+        self.kernel.params.height = height;
         self.rebuild_renderer()?;
         self.log(json!({"event": "resize", "width": width, "height": height, "frame": self.frame}));
         Ok(())
@@ -563,8 +589,7 @@ impl App {
             self.pending_size = None;
             self.apply_resize(size)?;
         }
-        let moved_params =
-            std::mem::take(&mut self.camera_moved).then(|| self.kernel_scene().params);
+        let moved_params = std::mem::take(&mut self.camera_moved).then(|| self.params());
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };

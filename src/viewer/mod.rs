@@ -80,10 +80,13 @@ pub fn run(options: ViewOptions) -> Result<()> {
         ))
         .into());
     }
+    // Built once here (the BVH, the environment map's tables), and again only when the scene
+    // file changes; a camera move rewrites the camera's parameters alone.
+    let kernel = scene.try_kernel_scene()?;
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| {
         InputError(format!(
             "no display: glint view cannot connect to the window system ({e}); {NO_DISPLAY_HINT}"
         ))
     })?;
-    app::run(event_loop, scene, options)
+    app::run(event_loop, scene, kernel, options)
 }
