@@ -45,12 +45,14 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {
-        if aovs_on() {
-            (*path).aov = aov_record_miss((*path).aov);
-        }
         var escaped = params.background;
         if HAS_ENVIRONMENT {
             escaped = environment_radiance(ray.dir);
+        }
+        if aovs_on() {
+            (*path).aov = aov_record_miss((*path).aov, escaped);
+        }
+        if HAS_ENVIRONMENT {
             // The map is an emitter like the others: a BSDF-sampled ray that reaches it
             // shares its light with next-event estimation from the previous vertex.
             if light_sampling && !(*path).came_from_delta {

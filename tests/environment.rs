@@ -538,3 +538,35 @@ fn a_map_larger_than_the_device_allows_is_refused() {
     assert!(stderr.contains("MiB"), "{stderr}");
     assert!(!out.exists());
 }
+
+/// The denoiser's albedo guide where a ray escapes is the clamped radiance it sees there: the
+/// map's, in its direction (here one colour, one channel above 1), on both devices.
+#[test]
+fn the_albedo_aov_of_escaping_rays_is_the_maps_clamped_radiance() {
+    let dir = tempfile::tempdir().unwrap();
+    let map = write_map(dir.path(), "m.exr", 8, 4, |_, _| [0.25, 0.5, 2.0]);
+    let scene = scene_in(
+        dir.path(),
+        &format!(
+            "{}[environment]\nfile = {:?}\n",
+            header([0.0; 3], [0.0, 0.0, 1.0], 60.0, 8, 1),
+            map.file_name().unwrap()
+        ),
+    );
+    let mut kernel = scene.kernel_scene();
+    kernel.params.aovs = 1;
+    let mut renderers: Vec<(&str, Box<dyn Renderer>)> =
+        vec![("cpu", Box::new(CpuRenderer::new(&kernel)))];
+    if let Some(ctx) = common::gpu() {
+        renderers.push(("gpu", Box::new(GpuRenderer::new(ctx, &kernel).unwrap())));
+    }
+    for (device, mut renderer) in renderers {
+        renderer.add_samples(2).unwrap();
+        let aovs = renderer.read_aovs().unwrap();
+        assert!(
+            aovs.albedo.pixels.iter().all(|p| *p == [0.25, 0.5, 1.0]),
+            "{device}: {:?}",
+            &aovs.albedo.pixels[..2]
+        );
+    }
+}

@@ -126,13 +126,15 @@ pub fn path_step(
     let hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
-        if aovs_on(params) {
-            aov_record_miss(&mut path.aov, params);
-        }
         // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
         let mut escaped = Vec3::from(params.background);
         if params.environment_width > 0 {
             escaped = environment_radiance(scene, ray.dir);
+        }
+        if aovs_on(params) {
+            aov_record_miss(&mut path.aov, escaped);
+        }
+        if params.environment_width > 0 {
             // The map is an emitter like the others: a BSDF-sampled ray that reaches it
             // shares its light with next-event estimation from the previous vertex.
             if light_sampling && !path.came_from_delta {
