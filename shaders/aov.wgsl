@@ -29,12 +29,13 @@ fn aov_start() -> PathAov {
     return PathAov(vec3<f32>(0.0), vec3<f32>(0.0), BACKGROUND_DEPTH, false);
 }
 
-// The path's ray left the scene: the background's clamped radiance is the albedo. (These
-// take and return values: naga's SPIR-V writer fails on pointers to a struct's member.)
-fn aov_record_miss(aov: PathAov) -> PathAov {
+// The path's ray left the scene: the clamped radiance it sees there (the background, or the
+// environment map in its direction) is the albedo. (These take and return values: naga's
+// SPIR-V writer fails on pointers to a struct's member.)
+fn aov_record_miss(aov: PathAov, escaped: vec3<f32>) -> PathAov {
     var out = aov;
     if !out.found {
-        out.albedo = clamp(params.background, vec3<f32>(0.0), vec3<f32>(1.0));
+        out.albedo = clamp(escaped, vec3<f32>(0.0), vec3<f32>(1.0));
         out.found = true;
     }
     return out;

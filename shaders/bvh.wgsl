@@ -131,6 +131,11 @@ fn bvh_closest_primitive(ray: Ray) -> ClosestPrimitive {
     return bvh_traverse(bvh_ray(ray), NO_HIT, NO_PRIMITIVE);
 }
 
+// Whether ray hits nothing: a shadow-ray search for any hit, with no target.
+fn bvh_escapes(ray: Ray) -> bool {
+    return bvh_traverse(bvh_ray(ray), NO_HIT, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
+}
+
 fn bvh_first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
     let r = bvh_ray(ray);
     let target_ref = (primitive << PRIMITIVE_KIND_SHIFT) | index;

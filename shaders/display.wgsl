@@ -1,7 +1,8 @@
 // Display pass of the viewer (host: src/viewer/display.rs): one fullscreen triangle whose
-// fragments read the renderer's running mean, scale it by 2^exposure, clamp it to [0, 1] and,
-// when the surface format does not encode sRGB itself, apply the sRGB transfer function. The
-// same steps as a PNG written by `glint render` (src/output.rs), so P saves what is shown.
+// fragments read an image (the renderer's running mean, or the denoised image), scale it by
+// 2^exposure, apply the tone curve (tonemap.wgsl, prepended by the host) and, when the surface
+// format does not encode sRGB itself, the sRGB transfer function. The same steps as a PNG
+// written by `glint render` (src/tonemap.rs, src/output.rs), so P saves what is shown.
 
 struct Display {
     // Size of the rendered image, and of the surface it is shown on; the image is stretched
@@ -12,11 +13,13 @@ struct Display {
     scale: f32,
     // 1 when the shader must sRGB-encode (a *Unorm surface), 0 for an *UnormSrgb one.
     encode_srgb: u32,
-    pad: vec2<u32>,
+    // TONEMAP_CLAMP, TONEMAP_ACES or TONEMAP_AGX.
+    tonemap: u32,
+    pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> display: Display;
-// Per pixel vec4: the running mean radiance (xyz), row-major, row 0 at the top.
+// Per pixel vec4: linear radiance (xyz), row-major, row 0 at the top.
 @group(0) @binding(1) var<storage, read> mean: array<vec4<f32>>;
 
 @vertex
@@ -37,9 +40,8 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     // Framebuffer coordinates have their origin at the top left, like the image's rows.
     let scaled = position.xy * vec2<f32>(display.image_size) / vec2<f32>(display.target_size);
     let pixel = min(vec2<u32>(scaled), display.image_size - vec2<u32>(1u));
-    let radiance = mean[pixel.y * display.image_size.x + pixel.x].xyz * display.scale;
-    // NaN shows as black, as in PNG output.
-    var color = clamp(select(radiance, vec3<f32>(0.0), radiance != radiance), vec3<f32>(0.0), vec3<f32>(1.0));
+    let radiance = mean[pixel.y * display.image_size.x + pixel.x].xyz;
+    var color = tonemap_apply(radiance, display.scale, display.tonemap);
     if display.encode_srgb != 0u {
         color = srgb_encode(color);
     }

@@ -110,11 +110,22 @@ fn closest_primitive(ray: Ray) -> ClosestPrimitive {
 
 // Whether the first thing `ray` meets is the primitive (primitive, index).
 fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
+    if HAS_ENVIRONMENT && primitive == PRIMITIVE_ENVIRONMENT {
+        return escapes(ray);
+    }
     if USE_BVH {
         return bvh_first_hit_is(ray, primitive, index);
     }
     let closest = closest_primitive(ray);
     return closest.t != NO_HIT && closest.primitive == primitive && closest.index == index;
+}
+
+// Whether ray leaves the scene without hitting anything (it then sees the environment).
+fn escapes(ray: Ray) -> bool {
+    if USE_BVH {
+        return bvh_escapes(ray);
+    }
+    return closest_primitive(ray).t == NO_HIT;
 }
 
 fn intersect_scene(ray: Ray) -> Hit {

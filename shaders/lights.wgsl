@@ -1,6 +1,7 @@
 // Light sampling for next-event estimation (mirror: src/cpu/lights.rs). An emitter is chosen
 // in proportion to its power, then a direction towards it: quads and triangles by area, spheres by the cone
-// of directions they subtend from outside, and by area from inside (where there is no cone).
+// of directions they subtend from outside, and by area from inside (where there is no cone), the
+// environment map by luminance (environment.wgsl).
 // All pdfs are per unit solid angle at the shading point and include the selection probability.
 
 struct LightSample {
@@ -20,6 +21,12 @@ fn pick_emitter(u: f32) -> u32 {
         }
     }
     return emitter_count() - 1u;
+}
+
+// Whether an emitter is the environment map; checked before the others, whose tests assume
+// a primitive.
+fn emitter_is_environment(primitive: u32) -> bool {
+    return HAS_ENVIRONMENT && primitive == PRIMITIVE_ENVIRONMENT;
 }
 
 // Whether an emitter is a triangle; known at compile time when the scene has no triangle
@@ -95,6 +102,13 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     out.primitive = e.primitive;
     out.index = e.index;
+    if emitter_is_environment(e.primitive) {
+        let s = sample_environment(u, rng);
+        out.dir = s.dir;
+        out.pdf = e.probability * s.pdf;
+        out.radiance = s.radiance;
+        return out;
+    }
     if emitter_is_triangle(e.primitive) {
         // Uniform on the triangle's area.
         let tri = triangles[e.index];
@@ -154,6 +168,9 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
 // The pdf with which sample_light(p, probe) would have produced `dir`, a direction that meets
 // the emitting primitive (primitive, index).
 fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, index: u32) -> f32 {
+    if emitter_is_environment(primitive) {
+        return params.environment_light_probability * environment_pdf(dir);
+    }
     if emitter_is_triangle(primitive) {
         let tri = triangles[index];
         let normal = triangle_normal(tri);

@@ -45,10 +45,22 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {
-        if aovs_on() {
-            (*path).aov = aov_record_miss((*path).aov);
+        var escaped = params.background;
+        if HAS_ENVIRONMENT {
+            escaped = environment_radiance(ray.dir);
         }
-        (*path).radiance += firefly_clamp((*path).throughput * params.background, bounce);
+        if aovs_on() {
+            (*path).aov = aov_record_miss((*path).aov, escaped);
+        }
+        if HAS_ENVIRONMENT {
+            // The map is an emitter like the others: a BSDF-sampled ray that reaches it
+            // shares its light with next-event estimation from the previous vertex.
+            if light_sampling && !(*path).came_from_delta {
+                let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, PRIMITIVE_ENVIRONMENT, 0u);
+                escaped *= power_heuristic((*path).bsdf_pdf_of_ray, pdf);
+            }
+        }
+        (*path).radiance += firefly_clamp((*path).throughput * escaped, bounce);
         return true;
     }
     let m = material_at(materials[hit.material], hit.uv);

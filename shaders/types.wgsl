@@ -38,8 +38,15 @@ struct Params {
     radiance_clamp: f32,
     // Meshes (issue 11).
     triangle_count: u32,
-    pad2: u32,
-    pad3: u32,
+    // The environment map's size in texels (0 x 0: none; `background` lights the scene).
+    environment_width: u32,
+    environment_height: u32,
+    // cos and sin of the map's rotation about +y (environment.wgsl).
+    environment_cos: f32,
+    environment_sin: f32,
+    // Probability that light sampling picks the environment map (0 when it is not sampled).
+    environment_light_probability: f32,
+    pad4: u32,
 }
 
 struct Sphere {
@@ -158,6 +165,23 @@ struct TriangleUvs {
     uv0: vec2<f32>,
     uv1: vec2<f32>,
     uv2: vec2<f32>,
+}
+
+// The emitter table's entry for the environment map (index 0).
+const PRIMITIVE_ENVIRONMENT: u32 = 3u;
+
+// One texel of the environment map: its radiance, and the solid-angle density with which
+// environment sampling picks a direction in it (selection among emitters excluded).
+struct EnvironmentTexel {
+    radiance: vec3<f32>,
+    pdf: f32,
+}
+
+// An entry of the alias table over the environment map's texels: texel k is kept with
+// probability `threshold`, else texel `alias` is taken.
+struct EnvironmentAlias {
+    threshold: f32,
+    alias_texel: u32,
 }
 
 struct Ray {

@@ -1,11 +1,15 @@
 //! The benchmark behind `glint bench`: a fixed set of renders of the Cornell box (256² and
 //! 512², max_bounces 8, light sampling on and off) on the GPU and the CPU reference, each run
-//! several times after a warm-up, reported as medians.
+//! several times after a warm-up, reported as medians. With mesh sizes, the Cornell box with a
+//! generated bumpy sphere of about that many triangles inside instead (256², light sampling
+//! on): paths/s against primitive count.
 
 use crate::render::Renderer;
-use crate::scene::{KernelScene, RenderOverrides, Scene};
+use crate::scene::stress::StressMesh;
+use crate::scene::{KernelScene, RenderOverrides, Scene, Triangle};
 use crate::shader::SceneBinding;
 use anyhow::Result;
+use glam::Vec3;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
@@ -36,6 +40,8 @@ pub struct BenchCase {
     /// Samples per pixel in one run, and per batch (one GPU submission).
     pub spp: u32,
     pub batch_spp: u32,
+    /// Triangles of the stress mesh added to the box (0: the plain Cornell box).
+    pub mesh_triangles: u32,
 }
 
 /// The fixed set: `quick` shrinks it to a smoke test (64² and 32², 2 spp) for the test suite.
@@ -51,6 +57,7 @@ pub fn cases(quick: bool) -> Vec<BenchCase> {
                         light_sampling,
                         spp: 2,
                         batch_spp: 1,
+                        mesh_triangles: 0,
                     }
                 } else {
                     BenchCase {
@@ -59,6 +66,7 @@ pub fn cases(quick: bool) -> Vec<BenchCase> {
                         light_sampling,
                         spp,
                         batch_spp,
+                        mesh_triangles: 0,
                     }
                 });
             }
@@ -67,8 +75,54 @@ pub fn cases(quick: bool) -> Vec<BenchCase> {
     out
 }
 
-pub fn case_scene(case: &BenchCase) -> KernelScene {
-    let scene = Scene::parse(CORNELL_TOML, Path::new("cornell.toml"))
+/// The mesh cases: for each size in `mesh_triangles` (0: the plain box), the Cornell box with
+/// a stress mesh of about that many triangles, at 256² with light sampling, on each device.
+/// `quick` shrinks them as [`cases`] does.
+pub fn mesh_cases(mesh_triangles: &[u32], quick: bool) -> Vec<BenchCase> {
+    let mut out = Vec::new();
+    for device in [BenchDevice::Gpu, BenchDevice::Cpu] {
+        for &triangles in mesh_triangles {
+            out.push(BenchCase {
+                device,
+                size: if quick { 32 } else { 256 },
+                light_sampling: true,
+                spp: if quick { 2 } else { 8 },
+                batch_spp: if quick { 1 } else { 2 },
+                mesh_triangles: triangles,
+            });
+        }
+    }
+    out
+}
+
+/// The bumpy sphere (`glint stress-mesh`'s) of about `triangles` triangles, white, standing in
+/// the middle of the box clear of its two spheres.
+fn add_stress_mesh(scene: &mut Scene, triangles: u32) {
+    let mesh = StressMesh::with_triangles(triangles as usize);
+    let material = scene
+        .materials
+        .iter()
+        .position(|m| m.name == "white")
+        .expect("the Cornell box has a white material") as u32;
+    let place = |p: Vec3| p * 80.0 + Vec3::new(278.0, 330.0, 300.0);
+    for t in &mesh.indices {
+        let [a, b, c] = t.map(|i| i as usize);
+        scene.triangles.push(Triangle {
+            vertices: [
+                place(mesh.positions[a]),
+                place(mesh.positions[b]),
+                place(mesh.positions[c]),
+            ],
+            normals: Some([mesh.normals[a], mesh.normals[b], mesh.normals[c]]),
+            material,
+            uvs: None,
+        });
+    }
+}
+
+/// The case's scene; an error when a mesh's BVH cannot be built.
+pub fn case_scene(case: &BenchCase) -> Result<KernelScene> {
+    let mut scene = Scene::parse(CORNELL_TOML, Path::new("cornell.toml"))
         .expect("the built-in Cornell box is valid")
         .with_overrides(&RenderOverrides {
             width: Some(case.size),
@@ -79,7 +133,10 @@ pub fn case_scene(case: &BenchCase) -> KernelScene {
             ..Default::default()
         })
         .expect("benchmark sizes are valid");
-    scene.kernel_scene()
+    if case.mesh_triangles > 0 {
+        add_stress_mesh(&mut scene, case.mesh_triangles);
+    }
+    Ok(scene.try_kernel_scene()?)
 }
 
 #[derive(Clone, Debug)]
@@ -95,6 +152,8 @@ pub struct BenchResult {
     pub segments_per_path: Option<f64>,
     /// The GPU kernel's scene binding (None on the CPU).
     pub scene_binding: Option<SceneBinding>,
+    /// Triangles in the scene (the stress mesh's actual count).
+    pub triangles: usize,
 }
 
 impl BenchResult {
@@ -153,5 +212,6 @@ pub fn run_case(renderer: &mut dyn Renderer, case: BenchCase, runs: usize) -> Re
         kernel_ms_per_batch: (!kernel_ms.is_empty()).then(|| median(&mut kernel_ms)),
         segments_per_path: (!segments.is_empty()).then(|| median(&mut segments)),
         scene_binding: None,
+        triangles: 0,
     })
 }

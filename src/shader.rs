@@ -8,7 +8,7 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 14] = [
+pub const SHADER_PARTS: [(&str, &str); 15] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -18,6 +18,10 @@ pub const SHADER_PARTS: [(&str, &str); 14] = [
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
+    (
+        "environment.wgsl",
+        include_str!("../shaders/environment.wgsl"),
+    ),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
     (
@@ -156,6 +160,9 @@ pub struct KernelFeatures {
     pub aovs: bool,
     /// Textured materials: texture coordinates at hits and lookups (shaders/texture.wgsl).
     pub textures: bool,
+    /// An environment map (`[environment]`, shaders/environment.wgsl) in place of the
+    /// constant background, and light sampling of it when that is on.
+    pub environment: bool,
 }
 
 impl KernelFeatures {
@@ -169,6 +176,7 @@ impl KernelFeatures {
         dielectric: true,
         aovs: true,
         textures: true,
+        environment: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -184,6 +192,7 @@ impl KernelFeatures {
             dielectric: has_kind(MATERIAL_DIELECTRIC),
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
+            environment: scene.params.environment_width > 0,
         }
     }
 
@@ -198,6 +207,7 @@ impl KernelFeatures {
             && needs(self.dielectric, other.dielectric)
             && needs(self.aovs, other.aovs)
             && needs(self.textures, other.textures)
+            && needs(self.environment, other.environment)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -206,7 +216,7 @@ impl KernelFeatures {
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
              const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n\
-             const HAS_TEXTURES: bool = {};\n",
+             const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -214,7 +224,8 @@ impl KernelFeatures {
             self.metal,
             self.dielectric,
             self.aovs,
-            self.textures
+            self.textures,
+            self.environment
         )
     }
 }

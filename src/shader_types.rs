@@ -42,8 +42,15 @@ pub struct Params {
     pub radiance_clamp: f32,
     /// Meshes (issue 11).
     pub triangle_count: u32,
-    pub pad2: u32,
-    pub pad3: u32,
+    /// The environment map's size in texels (0 × 0: none; `background` lights the scene).
+    pub environment_width: u32,
+    pub environment_height: u32,
+    /// cos and sin of the map's rotation about +y (`src/scene/environment.rs`).
+    pub environment_cos: f32,
+    pub environment_sin: f32,
+    /// Probability that light sampling picks the environment map (0 when it is not sampled).
+    pub environment_light_probability: f32,
+    pub pad4: u32,
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.
@@ -193,4 +200,25 @@ pub struct TriangleUvs {
     pub uv0: [f32; 2],
     pub uv1: [f32; 2],
     pub uv2: [f32; 2],
+}
+
+/// The emitter table's entry for the environment map (`index` 0).
+pub const PRIMITIVE_ENVIRONMENT: u32 = 3;
+
+/// One texel of the environment map: its radiance, and the solid-angle density with which
+/// environment sampling picks a direction in it (selection among emitters excluded).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EnvironmentTexel {
+    pub radiance: [f32; 3],
+    pub pdf: f32,
+}
+
+/// An entry of the alias table over the environment map's texels: texel k is kept with
+/// probability `threshold`, else texel `alias` is taken.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct EnvironmentAlias {
+    pub threshold: f32,
+    pub alias_texel: u32,
 }

@@ -618,3 +618,196 @@ fn total_internal_reflection_always_reflects() {
         assert_eq!(s.weight, Vec3::ONE);
     }
 }
+
+// ---- Environment map ------------------------------------------------------------------------
+
+/// A test environment map: its size, rotation and texels (linear radiance, top row first).
+struct MapCase {
+    name: &'static str,
+    width: u32,
+    height: u32,
+    rotate: f32,
+    texel: fn(u32, u32) -> [f32; 3],
+}
+
+fn map_cases() -> [MapCase; 2] {
+    [
+        // Smooth colour gradients, a black band at the bottom (pdf 0: never sampled), rotated.
+        MapCase {
+            name: "smooth 64x32, rotated 30°",
+            width: 64,
+            height: 32,
+            rotate: 30.0,
+            texel: |x, y| {
+                if y >= 28 {
+                    return [0.0; 3];
+                }
+                let (u, v) = (x as f32 / 64.0, y as f32 / 32.0);
+                [0.2 + u, 0.5 + 0.4 * (6.0 * u).sin(), 1.0 - v]
+            },
+        },
+        // A dim sky with a one-texel sun 10⁵ times brighter: most samples go to one texel.
+        MapCase {
+            name: "tiny sun 256x128",
+            width: 256,
+            height: 128,
+            rotate: 0.0,
+            texel: |x, y| {
+                if (x, y) == (40, 30) {
+                    return [1e5, 0.9e5, 0.8e5];
+                }
+                [
+                    0.05 + 0.4 * x as f32 / 256.0,
+                    0.3,
+                    0.5 - 0.3 * y as f32 / 128.0,
+                ]
+            },
+        },
+    ]
+}
+
+/// A scene lit only by `case`'s map, written as EXR into `dir`.
+fn environment_scene(case: &MapCase, dir: &std::path::Path) -> glint::scene::Scene {
+    let path = dir.join(format!("{}x{}.exr", case.width, case.height));
+    image::Rgb32FImage::from_fn(case.width, case.height, |x, y| {
+        image::Rgb((case.texel)(x, y))
+    })
+    .save(&path)
+    .unwrap();
+    common::scene(&format!(
+        "{SCENE_HEADER}[environment]\nfile = {:?}\nrotate = {}\n",
+        path.to_str().unwrap(),
+        case.rotate
+    ))
+}
+
+/// The map-frame (u, v) of a scene direction, in f64: turned back by the rotation, then
+/// u = atan2(x, −z)/2π, v = acos(y)/π (src/scene/environment.rs), written independently.
+fn map_uv(case: &MapCase, d: glam::DVec3) -> (f64, f64) {
+    let a = (case.rotate as f64).to_radians();
+    let (c, s) = (a.cos(), a.sin());
+    let m = glam::DVec3::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z).normalize();
+    let u = m.x.atan2(-m.z).rem_euclid(2.0 * PI) / (2.0 * PI);
+    (u, m.y.clamp(-1.0, 1.0).acos() / PI)
+}
+
+/// The reference pdf: luminance over ∫ luminance dω, with each texel's exact solid angle
+/// (2π/W)(cos θ_j − cos θ_j+1), from the formulas rather than the renderer's tables.
+fn reference_environment_pdf(case: &MapCase) -> impl Fn(glam::DVec3) -> f64 + '_ {
+    let lum = |c: [f32; 3]| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64;
+    let (w, h) = (case.width, case.height);
+    let row_solid_angle = move |y: u32| {
+        2.0 * PI / w as f64
+            * ((PI * y as f64 / h as f64).cos() - (PI * (y + 1) as f64 / h as f64).cos())
+    };
+    let total: f64 = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| lum((case.texel)(x, y)) * row_solid_angle(y))
+        .sum();
+    move |d: glam::DVec3| {
+        let (u, v) = map_uv(case, d);
+        let x = ((u * w as f64) as u32).min(w - 1);
+        let y = ((v * h as f64) as u32).min(h - 1);
+        lum((case.texel)(x, y)) / total
+    }
+}
+
+/// χ² of sampled directions on a grid aligned with the texels, each split in 2×2 cells equal
+/// in φ and in cos θ (so the within-texel distribution is tested too); the pdf is constant over
+/// each cell, so the expected counts are exact: N · pdf · the cell's solid angle. Also checks
+/// the pdf each sample reports against the reference.
+fn check_environment_samples(case: &MapCase, name: &str, samples: &[[f32; 4]]) {
+    let pdf = reference_environment_pdf(case);
+    let (w, h) = (case.width as usize, case.height as usize);
+    let (cols, rows) = (2 * w, 2 * h);
+    let cos_edge = |y: usize, half: usize| {
+        // cos θ at the top of texel row y (half 0), halfway in cos θ (1), at its bottom (2).
+        let top = (PI * y as f64 / h as f64).cos();
+        let bottom = (PI * (y + 1) as f64 / h as f64).cos();
+        top + (bottom - top) * half as f64 / 2.0
+    };
+    let mut observed = vec![0u64; cols * rows];
+    for (k, s) in samples.iter().enumerate() {
+        let d = glam::DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64);
+        assert!(
+            (d.length() - 1.0).abs() < 1e-4,
+            "{name}: not a unit vector: {d}"
+        );
+        let reference = pdf(d);
+        assert!(reference > 0.0, "{name}: sample {d} where the pdf is 0");
+        if k % 997 == 0 {
+            assert!(
+                (s[3] as f64 / reference - 1.0).abs() < 1e-3,
+                "{name}: sample pdf {} vs {reference}",
+                s[3]
+            );
+        }
+        let (u, v) = map_uv(case, d);
+        let x = ((u * w as f64) as usize).min(w - 1);
+        let y = ((v * h as f64) as usize).min(h - 1);
+        let column = (((u * w as f64) - x as f64) * 2.0).clamp(0.0, 1.0) as usize;
+        let cos = (v * PI).cos();
+        let lower_half = (cos < cos_edge(y, 1)) as usize;
+        observed[(2 * y + lower_half) * cols + 2 * x + column.min(1)] += 1;
+    }
+    let mut expected = vec![0.0; observed.len()];
+    for y in 0..h {
+        for half in 0..2 {
+            let cell_solid_angle = PI / w as f64 * (cos_edge(y, half) - cos_edge(y, half + 1));
+            for x in 0..w {
+                let theta = PI * (y as f64 + 0.5) / h as f64;
+                let phi = 2.0 * PI * (x as f64 + 0.5) / w as f64;
+                let m = glam::DVec3::new(
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                    -theta.sin() * phi.cos(),
+                );
+                // Back to the scene frame: turned by +rotate about +y.
+                let a = (case.rotate as f64).to_radians();
+                let d = glam::DVec3::new(
+                    a.cos() * m.x + a.sin() * m.z,
+                    m.y,
+                    a.cos() * m.z - a.sin() * m.x,
+                );
+                let p = pdf(d) * cell_solid_angle * samples.len() as f64;
+                for column in 0..2 {
+                    expected[(2 * y + half) * cols + 2 * x + column] = p;
+                }
+            }
+        }
+    }
+    assert_fits(name, &Ok(pearson(&observed, &expected)));
+}
+
+#[test]
+fn cpu_environment_sampling() {
+    let dir = tempfile::tempdir().unwrap();
+    for (k, case) in map_cases().iter().enumerate() {
+        let kernel = environment_scene(case, dir.path()).kernel_scene();
+        let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
+        let samples: Vec<[f32; 4]> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 101 + k as u32);
+                let s = glint::cpu::lights::sample_light(&refs, Vec3::ZERO, Vec3::ZERO, &mut r);
+                [s.dir.x, s.dir.y, s.dir.z, s.pdf]
+            })
+            .collect();
+        check_environment_samples(case, &format!("cpu environment, {}", case.name), &samples);
+    }
+}
+
+#[test]
+fn gpu_environment_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    for (k, case) in map_cases().iter().enumerate() {
+        let kernel = environment_scene(case, dir.path()).kernel_scene();
+        let samples = run_probe(
+            ctx,
+            "probe_light",
+            probe(Vec3::Z, SAMPLES, SEED + 111 + k as u32),
+            &kernel,
+        );
+        check_environment_samples(case, &format!("gpu environment, {}", case.name), &samples);
+    }
+}

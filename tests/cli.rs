@@ -528,3 +528,38 @@ fn bench_runs_and_its_ray_counts_agree_between_devices() {
         assert!(cpu > if light { 4.0 } else { 2.0 }, "{cpu}");
     }
 }
+
+/// A bad command line is one line on stderr and exit code 2, whatever the command, like every
+/// other bad input; clap's usage block and tips are left out, its details kept.
+#[test]
+fn bad_command_lines_are_one_line_with_exit_2() {
+    for (args, needle) in [
+        (vec!["render"], "<SCENE>"),
+        (vec!["render", "x.toml", "--no-such-flag"], "--no-such-flag"),
+        (
+            vec!["render", "x.toml", "--tonemap", "foo"],
+            "clamp, aces or agx",
+        ),
+        (vec!["render", "x.toml", "--spp", "-3"], "--spp"),
+        (vec!["merge"], "required"),
+        (vec!["compare", "a.exr"], "<B>"),
+        (vec!["no-such-command"], "no-such-command"),
+    ] {
+        let out = std::process::Command::new(GLINT)
+            .args(&args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.starts_with("glint: error:"), "{args:?}: {stderr}");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    }
+    // --help still prints the help, on stdout, with exit code 0.
+    let out = std::process::Command::new(GLINT)
+        .args(["render", "--help"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Usage"));
+}

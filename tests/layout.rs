@@ -6,8 +6,8 @@ use glint::shader::{
     SceneCounts, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use glint::shader_types::{
-    BvhNode, Emitter, Material, Params, Quad, Sphere, Texture, Triangle, TriangleNormals,
-    TriangleUvs,
+    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Material, Params, Quad, Sphere, Texture,
+    Triangle, TriangleNormals, TriangleUvs,
 };
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
@@ -106,8 +106,12 @@ fn rust_structs_match_wgsl_layout() {
             aovs,
             radiance_clamp,
             triangle_count,
-            pad2,
-            pad3
+            environment_width,
+            environment_height,
+            environment_cos,
+            environment_sin,
+            environment_light_probability,
+            pad4
         ]
     );
     assert_same_layout!(
@@ -176,6 +180,18 @@ fn rust_structs_match_wgsl_layout() {
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
     assert_eq!(size_of::<Material>(), 48, "Material stays 48 bytes");
+    assert_same_layout!(
+        &module,
+        EnvironmentTexel,
+        "EnvironmentTexel",
+        [radiance, pdf]
+    );
+    assert_same_layout!(
+        &module,
+        EnvironmentAlias,
+        "EnvironmentAlias",
+        [threshold, alias_texel]
+    );
 }
 
 #[test]
@@ -279,7 +295,7 @@ fn every_feature_combination_validates() {
         materials: 5,
         emitters: 1,
     };
-    for bits in 0..256u32 {
+    for bits in 0..512u32 {
         let features = KernelFeatures {
             light_sampling: bits & 1 != 0,
             sphere_emitters: bits & 2 != 0,
@@ -288,7 +304,8 @@ fn every_feature_combination_validates() {
             dielectric: bits & 16 != 0,
             aovs: bits & 32 != 0,
             triangle_emitters: bits & 64 != 0,
-            textures: bits & 128 != 0,
+            environment: bits & 128 != 0,
+            textures: bits & 256 != 0,
         };
         for binding in [
             SceneBinding::Storage,

@@ -339,3 +339,221 @@ fn gpu_closed_mesh_has_no_leaks_at_edges_and_vertices() {
         "rays that slipped through the closed mesh on the GPU"
     );
 }
+
+/// Renders `scene` to 256 spp: its mean and the variance image of its pixel means.
+fn mean_and_variance(
+    renderer: &mut dyn glint::render::Renderer,
+) -> (glint::output::Image, glint::output::Image) {
+    while renderer.samples() < 256 {
+        renderer.add_samples(64).unwrap();
+    }
+    (
+        renderer.read_mean().unwrap(),
+        renderer.read_variance().unwrap(),
+    )
+}
+
+/// A finely tessellated sphere (smooth-shaded, 256 segments × 128 rings, 65,024 triangles)
+/// renders the analytic sphere's image, up to the tessellation error derived here, on the
+/// sphere's pixels away from its silhouette.
+///
+/// Scene: a diffuse sphere (ρ = 0.8, radius 1) 0.5 above a diffuse floor (0.5) under a white
+/// sky (L = 1), two bounces: the light a point receives varies smoothly with its position and
+/// normal (no hard terminator). With Δ = π/128 the largest angle between neighbouring
+/// vertices, the differences from the analytic sphere are bounded by:
+/// 1. the shading normal's error θ: |ΔE| ≤ L ∫|Δn·ω| dω = 2π L θ, radiance 2ρLθ. θ is
+///    measured below on the mesh itself (area-weighted vertex normals; interpolated normals of
+///    unit vertex vectors are radial to second order);
+/// 2. directions between the geometric and the shading tangent planes carry nothing (no light
+///    leaks): a lune of 2ε sr, cosine ≤ ε, with ε ≤ Δ the angle between the two normals: ΔE ≤
+///    2Lε², radiance 2ρLε²/π;
+/// 3. the hit point lies up to the sagitta s = 1 − cos(Δ/√2) inside the sphere, which shifts
+///    the floor's outline as seen from it by at most s/g (g = 0.5, the gap to the floor): ΔE ≤
+///    2π L s/g, radiance 2ρLs/g.
+///
+/// Their sum δ (about 1.6·10⁻³ here) is added to the per-pixel Z-test's threshold
+/// (2.576 √(VA + VB) + δ, 97% of pixel channels must pass, as in tests/statistics.rs) and to
+/// the image means' (4σ + δ). Pixels within a pixel's diagonal plus s of the silhouette are
+/// left out, where the outlines themselves differ.
+#[test]
+fn tessellated_sphere_matches_the_analytic_sphere() {
+    let dir = tempfile::tempdir().unwrap();
+    let (segments, rings) = (256, 128);
+    let mesh = StressMesh::displaced(segments, rings, 0.0);
+    mesh.write_ply(&dir.path().join("sphere.ply")).unwrap();
+    let normal_error = mesh
+        .positions
+        .iter()
+        .zip(&mesh.normals)
+        .map(|(p, n)| p.normalize().angle_between(*n))
+        .fold(0.0f32, f32::max) as f64;
+    let delta_angle = std::f64::consts::PI / rings as f64;
+    let sagitta = 1.0 - (delta_angle / 2f64.sqrt()).cos();
+    let (rho, sky, gap) = (0.8, 1.0, 0.5);
+    let delta = 2.0 * rho * sky * normal_error
+        + 2.0 * rho * sky * delta_angle * delta_angle / std::f64::consts::PI
+        + 2.0 * rho * sky * sagitta / gap;
+    eprintln!("vertex normal error {normal_error:.2e} rad, sagitta {sagitta:.2e}, δ = {delta:.2e}");
+    let (size, vfov) = (32u32, 35.0f64);
+    let header = format!(
+        r#"
+[camera]
+eye = [0.0, 0.0, -4.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = {vfov:?}
+[render]
+width = {size}
+height = {size}
+spp = 1
+max_bounces = 2
+background = [{sky:?}, {sky:?}, {sky:?}]
+[materials.ball]
+type = "diffuse"
+color = [{rho:?}, {rho:?}, {rho:?}]
+[materials.floor]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+[[quads]]
+corner = [-20.0, -1.5, -20.0]
+u = [0.0, 0.0, 40.0]
+v = [40.0, 0.0, 0.0]
+material = "floor"
+"#
+    );
+    let load = |name: &str, text: String, seed: u32| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        common::sized(Scene::load(&path).unwrap(), size, seed)
+    };
+    let tessellated = load(
+        "tessellated.toml",
+        format!("{header}[[meshes]]\nfile = \"sphere.ply\"\nmaterial = \"ball\"\n"),
+        1,
+    );
+    let analytic = load(
+        "analytic.toml",
+        format!(
+            "{header}[[spheres]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"ball\"\n"
+        ),
+        2,
+    );
+    let a = match gpu() {
+        Some(ctx) => {
+            mean_and_variance(&mut glint::gpu::GpuRenderer::new(ctx, &tessellated).unwrap())
+        }
+        None => mean_and_variance(&mut glint::cpu::renderer::CpuRenderer::new(&tessellated)),
+    };
+    let b = mean_and_variance(&mut glint::cpu::renderer::CpuRenderer::new(&analytic));
+    // Pixels whose centre ray passes within 1 − s − (half a pixel diagonal at the sphere) of
+    // the centre.
+    let pixel_angle = (vfov.to_radians() / 2.0).tan() * 2.0 / size as f64;
+    let margin = sagitta + 4.0 * pixel_angle * std::f64::consts::SQRT_2 / 2.0;
+    let (mut tested, mut passed) = (0usize, 0usize);
+    let (mut sum_a, mut sum_b, mut sum_var) = (0.0f64, 0.0f64, 0.0f64);
+    for y in 0..size {
+        for x in 0..size {
+            let ndc = |i: u32| {
+                ((i as f64 + 0.5) / size as f64 * 2.0 - 1.0) * (vfov.to_radians() / 2.0).tan()
+            };
+            let d = glam::DVec3::new(-ndc(x), -ndc(y), 1.0).normalize();
+            let impact = glam::DVec3::new(0.0, 0.0, -4.0).cross(d).length();
+            if impact > 1.0 - margin {
+                continue;
+            }
+            let i = (y * size + x) as usize;
+            for c in 0..3 {
+                let (va, vb) = (a.1.pixels[i][c] as f64, b.1.pixels[i][c] as f64);
+                let diff = (a.0.pixels[i][c] - b.0.pixels[i][c]) as f64;
+                tested += 1;
+                passed += (diff.abs() <= 2.575_829 * (va + vb).sqrt() + delta) as usize;
+                sum_a += a.0.pixels[i][c] as f64;
+                sum_b += b.0.pixels[i][c] as f64;
+                sum_var += va + vb;
+            }
+        }
+    }
+    let n = tested as f64;
+    let (mean_diff, sigma) = ((sum_a - sum_b) / n, sum_var.sqrt() / n);
+    eprintln!(
+        "{tested} pixel channels: {:.2}% within the Z-test's threshold + δ; means differ by \
+         {mean_diff:.2e} (σ {sigma:.2e}, δ {delta:.2e})",
+        100.0 * passed as f64 / n
+    );
+    assert!(tested > 1000, "{tested}");
+    assert!(passed as f64 >= 0.97 * n, "{passed} of {tested}");
+    assert!(
+        mean_diff.abs() <= 4.0 * sigma + delta,
+        "{mean_diff} vs {sigma} + {delta}"
+    );
+}
+
+/// The furnace (tests/closed_form.rs) with the enclosing sphere a closed triangle mesh: the
+/// camera inside a mesh that emits 0.5 and reflects half the light. Every path gathers
+/// 0.5 + 0.25 + … = 1 − 2^−(B+1) after B bounces, exactly, if every ray meets the mesh and
+/// its emission is counted once per vertex. With light sampling (each triangle an emitter,
+/// MIS with the BSDF) it holds in expectation: the image mean within 5σ of its variance image.
+#[test]
+fn furnace_inside_a_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    StressMesh::displaced(24, 12, 0.0)
+        .write_ply(&dir.path().join("sphere.ply"))
+        .unwrap();
+    let bounces = 6;
+    let expected = 1.0 - 0.5f64.powi(bounces + 1);
+    for light_sampling in [false, true] {
+        let text = format!(
+            r#"
+[camera]
+eye = [0.1, -0.2, 0.05]
+target = [0.5, 0.3, 1.0]
+up = [0.0, 1.0, 0.0]
+vfov = 70.0
+[render]
+width = 16
+height = 16
+spp = 1
+max_bounces = {bounces}
+light_sampling = {light_sampling}
+russian_roulette = false
+[materials.shell]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+emission = [0.5, 0.5, 0.5]
+[[meshes]]
+file = "sphere.ply"
+material = "shell"
+scale = 3.0
+smooth = false
+"#
+        );
+        let path = dir.path().join("furnace.toml");
+        std::fs::write(&path, text).unwrap();
+        let scene = Scene::load(&path).unwrap().kernel_scene();
+        let mut renderers: Vec<(&str, Box<dyn glint::render::Renderer>)> = vec![(
+            "cpu",
+            Box::new(glint::cpu::renderer::CpuRenderer::new(&scene)),
+        )];
+        if let Some(ctx) = gpu() {
+            renderers.push((
+                "gpu",
+                Box::new(glint::gpu::GpuRenderer::new(ctx, &scene).unwrap()),
+            ));
+        }
+        for (device, mut renderer) in renderers {
+            let (image, variance) = mean_and_variance(renderer.as_mut());
+            if light_sampling {
+                let sigma = (variance.mean() / image.pixels.len() as f64).sqrt();
+                let z = (image.mean() - expected) / sigma;
+                assert!(
+                    z.abs() < 5.0,
+                    "{device}: {} vs {expected} (z {z})",
+                    image.mean()
+                );
+            } else {
+                let worst = common::largest_deviation(&image, expected as f32);
+                assert!(worst < 1e-5, "{device}: off by {worst}");
+            }
+        }
+    }
+}

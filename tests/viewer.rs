@@ -134,6 +134,8 @@ fn mean_rgb(png: &image::RgbImage, x: (f32, f32), y: (f32, f32)) -> [f64; 3] {
 const LEFT_WALL: (f32, f32) = (0.06, 0.16);
 const RIGHT_WALL: (f32, f32) = (0.84, 0.94);
 const WALL_ROWS: (f32, f32) = (0.3, 0.7);
+/// A block of the back wall, between the light above and the spheres below.
+const BACK_WALL: ((f32, f32), (f32, f32)) = ((0.3, 0.7), (0.25, 0.5));
 
 #[test]
 fn cornell_screenshot_shows_the_green_and_red_walls() {
@@ -509,4 +511,256 @@ fn a_scene_replaced_by_a_fifo_or_dev_zero_does_not_freeze_the_window() {
     }
     child.kill().unwrap();
     child.wait().unwrap();
+}
+
+/// Whether Open Image Denoise loads here; where it does not, the denoising test says so and
+/// passes, except under GLINT_REQUIRE_OIDN (set by .ci/run, which installs it).
+fn oidn_available() -> bool {
+    match glint::denoise::oidn() {
+        Ok(_) => true,
+        Err(e) if std::env::var_os("GLINT_REQUIRE_OIDN").is_some() => {
+            panic!("GLINT_REQUIRE_OIDN is set: {e}")
+        }
+        Err(e) => {
+            eprintln!("skipping: {e}");
+            false
+        }
+    }
+}
+
+/// How far each pixel of a block of the PNG (as in [`mean_rgb`]) is from the mean of its left
+/// and right neighbours, on average, in sRGB levels: pixel noise raises it, while a smooth wall
+/// (its shading a gradient, which this second difference cancels) keeps it near 0.
+fn roughness(png: &image::RgbImage, x: (f32, f32), y: (f32, f32)) -> f64 {
+    let (w, h) = (png.width() as f32, png.height() as f32);
+    let mut sum = 0.0;
+    let mut n = 0.0;
+    for y in (y.0 * h) as u32..(y.1 * h) as u32 {
+        for x in (x.0 * w) as u32 + 1..(x.1 * w) as u32 - 1 {
+            let level = |x: u32, c: usize| png.get_pixel(x, y).0[c] as f64;
+            for c in 0..3 {
+                sum += (level(x, c) - 0.5 * (level(x - 1, c) + level(x + 1, c))).abs();
+                n += 1.0;
+            }
+        }
+    }
+    sum / n
+}
+
+#[test]
+fn d_denoises_the_shown_image_and_the_title_says_so() {
+    if skip_gpu() || !oidn_available() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let run = |script: &str, shot: &str| {
+        let mut args = vec![
+            cornell.to_str().unwrap(),
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--spp-per-frame",
+            "2",
+            "--frames",
+            "10",
+            "--screenshot",
+            shot,
+        ];
+        if !script.is_empty() {
+            args.extend(["--script", script]);
+        }
+        let out = view_command(&x, dir.path(), &args).output().unwrap();
+        succeeded(&out)
+    };
+    // D before the first frame; `wait-denoised` holds frame 3 until the background denoise
+    // started at frame 1 (the first with 2 spp or more) lands.
+    let log = run("0:denoise; 3:wait-denoised", "denoised.png");
+    let raw_log = run("", "raw.png");
+
+    let toggles = events(&log, "denoise");
+    assert_eq!(toggles.len(), 1, "{log:?}");
+    assert_eq!(toggles[0]["on"], true);
+    let landed = events(&log, "denoised");
+    assert!(!landed.is_empty(), "{log:?}");
+    assert_eq!(landed[0]["frame"], 3);
+    let shown: Vec<bool> = frames(&log)
+        .iter()
+        .map(|f| f["denoised"].as_bool().unwrap())
+        .collect();
+    assert_eq!(shown[..3], [false; 3], "nothing denoised before frame 3");
+    assert!(shown[3..].iter().all(|&s| s), "{shown:?}");
+    let titles: Vec<&str> = events(&log, "title")
+        .iter()
+        .map(|t| t["title"].as_str().unwrap())
+        .collect();
+    assert!(!titles.is_empty());
+    assert!(
+        titles.iter().all(|t| t.contains("· denoised")),
+        "{titles:?}"
+    );
+    assert!(events(&raw_log, "title")
+        .iter()
+        .all(|t| !t["title"].as_str().unwrap().contains("denoised")));
+    // The AOVs change nothing in the accumulation: both runs reach the same samples.
+    let spp = |log: &[Value]| -> Vec<u64> {
+        frames(log)
+            .iter()
+            .map(|f| f["spp"].as_u64().unwrap())
+            .collect()
+    };
+    assert_eq!(spp(&log), spp(&raw_log));
+
+    // The screenshot is the denoised image of the same samples: smooth where the raw one is
+    // noisy (19 spp), with the walls' colours kept.
+    let open = |name: &str| image::open(dir.path().join(name)).unwrap().into_rgb8();
+    let (denoised, raw) = (open("denoised.png"), open("raw.png"));
+    for (cols, rows) in [(LEFT_WALL, WALL_ROWS), (RIGHT_WALL, WALL_ROWS), BACK_WALL] {
+        let (rough_denoised, rough_raw) = (
+            roughness(&denoised, cols, rows),
+            roughness(&raw, cols, rows),
+        );
+        eprintln!("roughness: denoised {rough_denoised:.2}, raw {rough_raw:.2}");
+        assert!(
+            rough_denoised < 0.5 * rough_raw,
+            "denoised {rough_denoised}, raw {rough_raw}"
+        );
+        let (d, r) = (mean_rgb(&denoised, cols, rows), mean_rgb(&raw, cols, rows));
+        eprintln!("wall: denoised {d:?}, raw {r:?}");
+        // The raw block mean's own noise is under 1 level (σ ≈ 6 levels per pixel over ~100
+        // pixels); 8 levels catch a denoiser that darkens or tints a wall.
+        for c in 0..3 {
+            assert!((d[c] - r[c]).abs() < 8.0, "denoised {d:?}, raw {r:?}");
+        }
+    }
+}
+
+#[test]
+fn d_without_oidn_keeps_the_raw_image_and_says_why_once() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let out = view_command(
+        &x,
+        dir.path(),
+        &[
+            cornell.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp-per-frame",
+            "1",
+            "--frames",
+            "6",
+            "--script",
+            "0:denoise; 2:denoise; 4:denoise",
+        ],
+    )
+    // An explicit library path that does not exist is the only place looked.
+    .env("GLINT_OIDN_LIB", "/nonexistent/libOpenImageDenoise.so")
+    .output()
+    .unwrap();
+    let log = succeeded(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let why: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("Open Image Denoise"))
+        .collect();
+    assert_eq!(why.len(), 1, "{stderr}");
+    assert!(why[0].contains("raw image"), "{stderr}");
+    assert!(why[0].contains("pip install pyoidn"), "{stderr}");
+    let toggles = events(&log, "denoise");
+    assert_eq!(toggles.len(), 3, "{log:?}");
+    assert!(toggles.iter().all(|t| t["on"] == false));
+    assert!(events(&log, "denoised").is_empty());
+    assert!(frames(&log).iter().all(|f| f["denoised"] == false));
+    let titles = events(&log, "title");
+    assert!(!titles.is_empty());
+    for title in titles {
+        let title = title["title"].as_str().unwrap();
+        assert!(title.contains("no denoiser"), "{title}");
+        assert!(!title.contains("· denoised"), "{title}");
+    }
+}
+
+/// A PNG screenshot goes through `--tonemap` and `--exposure` (src/tonemap.rs) exactly; an EXR
+/// one stays linear. Same flags and frames, so both runs hold the same samples.
+#[test]
+fn tonemap_and_exposure_shape_png_screenshots_only() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    for shot in ["shot.exr", "shot.png"] {
+        let out = view_command(
+            &x,
+            dir.path(),
+            &[
+                cornell.to_str().unwrap(),
+                "--width",
+                "32",
+                "--height",
+                "32",
+                "--spp-per-frame",
+                "2",
+                "--frames",
+                "4",
+                "--tonemap",
+                "agx",
+                "--exposure",
+                "1.5",
+                "--screenshot",
+                shot,
+            ],
+        )
+        .output()
+        .unwrap();
+        succeeded(&out);
+    }
+    let linear = glint::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
+    let expected = glint::tonemap::DisplayTransform {
+        tonemap: glint::tonemap::Tonemap::Agx,
+        exposure: 1.5,
+    }
+    .image(&linear)
+    .to_srgb8();
+    let png = image::open(dir.path().join("shot.png"))
+        .unwrap()
+        .into_rgb8();
+    assert_eq!(png.into_raw(), expected);
+}
+
+/// `--tonemap` and `--exposure` are `glint render`'s (src/cli/tone.rs): the same values are
+/// refused the same way, in one line, before any window.
+#[test]
+fn bad_tonemap_or_exposure_for_view_exits_2() {
+    let cornell = scene_path("cornell.toml");
+    for (flag, value, needle) in [
+        ("--tonemap", "foo", "clamp, aces or agx"),
+        ("--exposure", "nan", "finite"),
+        ("--exposure", "inf", "finite"),
+    ] {
+        let out = Command::new(GLINT)
+            .args(["view", cornell.to_str().unwrap(), flag, value])
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{flag} {value}: {stderr}");
+        assert!(
+            stderr.starts_with("glint: error:") && stderr.contains(flag) && stderr.contains(needle),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("panicked"));
+    }
 }

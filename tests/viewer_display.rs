@@ -1,9 +1,10 @@
-//! The viewer's display pass: naga validates `shaders/display.wgsl`, the Rust uniform matches
-//! the WGSL struct, and on the GPU the pass shows mean × 2^exposure, clamped and sRGB-encoded,
-//! exactly as a PNG of the same mean would hold it.
+//! The viewer's display pass: naga validates `shaders/display.wgsl` (with `tonemap.wgsl`), the
+//! Rust uniform matches the WGSL struct, and on the GPU the pass shows mean × 2^exposure through
+//! each tone curve, sRGB-encoded, as a PNG of the same mean would hold it (src/tonemap.rs).
 
 mod common;
 use glint::output::srgb_byte;
+use glint::tonemap::{DisplayTransform, Tonemap};
 use glint::viewer::display::{
     DisplayPass, DisplayUniform, DISPLAY_SHADER, FRAGMENT_ENTRY_POINT, VERTEX_ENTRY_POINT,
 };
@@ -69,6 +70,7 @@ fn display_uniform_matches_wgsl_layout() {
             "encode_srgb".into(),
             offset_of!(DisplayUniform, encode_srgb) as u32,
         ),
+        ("tonemap".into(), offset_of!(DisplayUniform, tonemap) as u32),
         ("pad".into(), offset_of!(DisplayUniform, pad) as u32),
     ];
     assert_eq!(rust, wgsl);
@@ -76,7 +78,11 @@ fn display_uniform_matches_wgsl_layout() {
 }
 
 /// Draws a 4×2 mean image into a `format` texture of the same size and reads it back (RGBA).
-fn draw(format: wgpu::TextureFormat, mean: &[[f32; 4]], exposure: f32) -> Vec<[u8; 4]> {
+fn draw(
+    format: wgpu::TextureFormat,
+    mean: &[[f32; 4]],
+    transform: &DisplayTransform,
+) -> Vec<[u8; 4]> {
     let ctx = common::gpu().unwrap();
     let (w, h) = (4u32, 2u32);
     let mean_buffer = ctx
@@ -111,7 +117,7 @@ fn draw(format: wgpu::TextureFormat, mean: &[[f32; 4]], exposure: f32) -> Vec<[u
     pass.bind(&ctx.device, &mean_buffer);
     let view = texture.create_view(&Default::default());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    pass.draw(&ctx.queue, &mut encoder, &view, (w, h), (w, h), exposure);
+    pass.draw(&ctx.queue, &mut encoder, &view, (w, h), (w, h), transform);
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
@@ -161,22 +167,39 @@ fn display_pass_shows_what_a_png_holds() {
         [0.5, 0.75, 1.0, 0.0],
         [100.0, 0.01, 0.49, 0.0],
     ];
-    for exposure in [0.0f32, 1.0, -1.5] {
+    for (tonemap, exposure) in [
+        (Tonemap::Clamp, 0.0f32),
+        (Tonemap::Clamp, 1.0),
+        (Tonemap::Clamp, -1.5),
+        (Tonemap::Aces, 0.0),
+        (Tonemap::Aces, 2.0),
+        (Tonemap::Agx, 0.0),
+        (Tonemap::Agx, -1.0),
+    ] {
+        let transform = DisplayTransform { tonemap, exposure };
         let expected: Vec<[u8; 3]> = mean
             .iter()
-            .map(|p| [p[0], p[1], p[2]].map(|v| srgb_byte(v * exposure.exp2())))
+            .map(|p| transform.apply([p[0], p[1], p[2]]).map(srgb_byte))
             .collect();
+        if tonemap == Tonemap::Clamp {
+            // The clamp curve is mean × 2^exposure, clamped: what PNGs always held.
+            let plain: Vec<[u8; 3]> = mean
+                .iter()
+                .map(|p| [p[0], p[1], p[2]].map(|v| srgb_byte(v * exposure.exp2())))
+                .collect();
+            assert_eq!(expected, plain);
+        }
         for format in [
             wgpu::TextureFormat::Rgba8Unorm,
             wgpu::TextureFormat::Rgba8UnormSrgb,
         ] {
-            let got = draw(format, &mean, exposure);
+            let got = draw(format, &mean, &transform);
             for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
                 for c in 0..3 {
                     // The GPU's pow and the sRGB store may round a step differently.
                     assert!(
                         (g[c] as i32 - e[c] as i32).abs() <= 1,
-                        "{format:?}, exposure {exposure}, pixel {i}: got {g:?}, a PNG holds {e:?}"
+                        "{format:?}, {tonemap:?}, exposure {exposure}, pixel {i}: got {g:?}, a PNG holds {e:?}"
                     );
                 }
                 assert_eq!(g[3], 255);

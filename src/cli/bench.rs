@@ -1,6 +1,6 @@
 //! `glint bench`.
 
-use crate::bench::{case_scene, cases, run_case, BenchDevice, BenchResult};
+use crate::bench::{case_scene, cases, mesh_cases, run_case, BenchDevice, BenchResult};
 use crate::cpu::renderer::CpuRenderer;
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::shader::{SceneBinding, SceneCounts};
@@ -38,6 +38,11 @@ pub struct BenchArgs {
     /// Where the GPU kernel reads the scene from, to compare the two kernels.
     #[arg(long, value_enum, default_value_t = SceneBindingChoice::Auto)]
     pub scene_binding: SceneBindingChoice,
+    /// Instead of the fixed set: the Cornell box with a generated mesh of about this many
+    /// triangles (0: none), at 256² with light sampling, for paths/s against primitive count;
+    /// e.g. `--mesh-triangles 0,1000,100000,1000000`.
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u32).range(0..=4_000_000))]
+    pub mesh_triangles: Vec<u32>,
 }
 
 pub fn run(args: BenchArgs) -> Result<()> {
@@ -56,8 +61,13 @@ pub fn run(args: BenchArgs) -> Result<()> {
         );
     }
     let mut results = Vec::new();
-    for case in cases(args.quick) {
-        let scene = case_scene(&case);
+    let all_cases = if args.mesh_triangles.is_empty() {
+        cases(args.quick)
+    } else {
+        mesh_cases(&args.mesh_triangles, args.quick)
+    };
+    for case in all_cases {
+        let scene = case_scene(&case)?;
         let result = match (case.device, &gpu) {
             (BenchDevice::Gpu, Some(ctx)) => {
                 let mut renderer = match args.scene_binding {
@@ -80,6 +90,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
             }
             _ => continue,
         };
+        let result = BenchResult {
+            triangles: scene.triangles.len(),
+            ..result
+        };
         if !args.json {
             if results.is_empty() {
                 crate::outln!("{}", header());
@@ -99,6 +113,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
                     "height": r.case.size,
                     "max_bounces": 8,
                     "light_sampling": r.case.light_sampling,
+                    "triangles": r.triangles,
                     "spp_per_run": r.case.spp,
                     "spp_per_batch": r.case.batch_spp,
                     "runs": r.runs,
@@ -125,8 +140,16 @@ pub fn run(args: BenchArgs) -> Result<()> {
 
 fn header() -> String {
     format!(
-        "{:<14} {:>9} {:>6} {:>14} {:>14} {:>10} {:>10} {:>12}",
-        "device", "size", "light", "paths/s", "rays/s", "rays/path", "ms/batch", "kernel ms"
+        "{:<14} {:>9} {:>6} {:>10} {:>14} {:>14} {:>10} {:>10} {:>12}",
+        "device",
+        "size",
+        "light",
+        "triangles",
+        "paths/s",
+        "rays/s",
+        "rays/path",
+        "ms/batch",
+        "kernel ms"
     )
 }
 
@@ -135,13 +158,14 @@ fn row(r: &BenchResult) -> String {
         v.map_or("-".to_string(), |v| format!("{:.*}", digits, v / scale))
     };
     format!(
-        "{:<14} {:>9} {:>6} {:>12.2} M {:>12} M {:>10} {:>10.1} {:>12}",
+        "{:<14} {:>9} {:>6} {:>10} {:>12.2} M {:>12} M {:>10} {:>10.1} {:>12}",
         match r.scene_binding {
             Some(binding) => format!("{} ({})", r.case.device.as_str(), binding.name()),
             None => r.case.device.as_str().to_string(),
         },
         format!("{}²", r.case.size),
         if r.case.light_sampling { "on" } else { "off" },
+        r.triangles,
         r.paths_per_second / 1e6,
         opt(r.rays_per_second, 1e6, 2),
         opt(r.segments_per_path, 1.0, 2),

@@ -8,6 +8,7 @@ mod render;
 mod render_writer;
 mod sample_range;
 mod stress_mesh;
+mod tone;
 mod view;
 
 use crate::error::InputError;
@@ -43,11 +44,36 @@ pub enum Command {
 }
 
 /// Runs the command line; exit code 0 done, 2 bad input (scene or flags), 1 anything else.
+/// A bad command line: one line on stderr and exit code 2, like every other bad input (clap's
+/// own report adds a usage block and a hint). --help and --version print as clap does.
+fn usage_error(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        e.exit();
+    }
+    crate::errln!("glint: {}", first_paragraph(&e.render().to_string()));
+    ExitCode::from(2)
+}
+
+/// The text up to its first blank line, on one line: clap's message with its details (the
+/// possible values, the missing arguments) but not the usage block or the tips after it.
+fn first_paragraph(text: &str) -> String {
+    text.lines()
+        .take_while(|line| !line.trim().is_empty())
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
-        // clap exits with 2 on bad flags and 0 for --help and --version.
-        Err(e) => e.exit(),
+        Err(e) => return usage_error(e),
     };
     let result = match cli.command {
         Command::Render(args) => render::run(*args),

@@ -1,13 +1,14 @@
 //! `glint render`'s outputs beyond the mean: the denoiser's AOVs, the denoised image, tone
 //! mapping for PNG, and the firefly clamp. Checked before rendering, applied after.
 
+use super::tone::ToneArgs;
 use crate::denoise;
 use crate::error::InputError;
 use crate::output::{Image, ImageFormat};
 use crate::output_check::OutputSet;
 use crate::render::Renderer;
 use crate::shader_types::Params;
-use crate::tonemap::{parse_exposure, DisplayTransform, Tonemap};
+use crate::tonemap::DisplayTransform;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -31,13 +32,8 @@ pub struct PostArgs {
     /// Write the mean camera distance of the first hit to this .exr (background: 1e30).
     #[arg(long, value_name = "FILE.exr")]
     pub depth: Option<PathBuf>,
-    /// Tone curve for PNG output: clamp (default), aces (Narkowicz's fit) or agx (minimal AgX).
-    /// EXR output stays linear.
-    #[arg(long, value_name = "clamp|aces|agx", value_parser = Tonemap::parse)]
-    pub tonemap: Option<Tonemap>,
-    /// Exposure for PNG output, in stops (radiance × 2^EV before the tone curve).
-    #[arg(long, value_name = "EV", value_parser = parse_exposure, allow_negative_numbers = true)]
-    pub exposure: Option<f32>,
+    #[command(flatten)]
+    pub tone: ToneArgs,
     /// Firefly clamp (biased, off by default): each contribution of light that has scattered
     /// at least once is scaled down so its brightest channel is at most L.
     #[arg(long = "clamp", value_name = "L", value_parser = parse_clamp)]
@@ -54,10 +50,7 @@ fn parse_clamp(s: &str) -> Result<f32, String> {
 
 impl PostArgs {
     fn display(&self) -> DisplayTransform {
-        DisplayTransform {
-            tonemap: self.tonemap.unwrap_or_default(),
-            exposure: self.exposure.unwrap_or(0.0),
-        }
+        self.tone.transform()
     }
 
     fn aov_outputs(&self) -> [(&'static str, Option<&PathBuf>); 3] {

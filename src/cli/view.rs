@@ -1,5 +1,6 @@
 //! `glint view`.
 
+use super::tone::ToneArgs;
 use crate::error::InputError;
 use crate::scene::MAX_IMAGE_SIDE;
 use crate::viewer::{action::Script, ViewOptions};
@@ -26,6 +27,8 @@ pub struct ViewArgs {
     /// On exit, write what is shown (.png) or the linear mean radiance (.exr).
     #[arg(long, value_name = "FILE")]
     pub screenshot: Option<PathBuf>,
+    #[command(flatten)]
+    pub tone: ToneArgs,
     /// Tests: actions to inject before given frames, e.g. "5:orbit 40 0; 10:reload".
     #[arg(long, hide = true)]
     pub script: Option<String>,
@@ -46,6 +49,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         spp_per_frame: args.spp_per_frame,
         frames: args.frames,
         screenshot: args.screenshot,
+        display: args.tone.transform(),
         script,
         log_frames: args.log_frames,
     })

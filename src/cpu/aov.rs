@@ -35,10 +35,11 @@ pub fn aov_start() -> PathAov {
     }
 }
 
-/// The path's ray left the scene: the background's clamped radiance is the albedo.
-pub fn aov_record_miss(aov: &mut PathAov, params: &Params) {
+/// The path's ray left the scene: the clamped radiance it sees there (the background, or the
+/// environment map in its direction) is the albedo.
+pub fn aov_record_miss(aov: &mut PathAov, escaped: Vec3) {
     if !aov.found {
-        aov.albedo = Vec3::from(params.background).clamp(Vec3::ZERO, Vec3::ONE);
+        aov.albedo = escaped.clamp(Vec3::ZERO, Vec3::ONE);
         aov.found = true;
     }
 }

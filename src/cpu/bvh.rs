@@ -8,7 +8,8 @@ use super::intersect::{hit_quad, hit_sphere, ClosestPrimitive, Geometry, NO_HIT}
 use super::triangle::{hit_triangle, triangle_ray, TriangleRay};
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
+    BvhNode, PRIMITIVE_ENVIRONMENT, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
+    PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -174,6 +175,12 @@ pub fn bvh_traverse(
 
 pub fn bvh_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
     bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_PRIMITIVE)
+}
+
+/// Whether `ray` hits nothing: a shadow-ray search for any hit, with no target.
+pub fn bvh_escapes(geometry: &Geometry, ray: &Ray) -> bool {
+    let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
+    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, no_target).t == NO_HIT
 }
 
 pub fn bvh_first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u32) -> bool {

@@ -1,6 +1,6 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
-use super::bvh::{bvh_closest_primitive, bvh_first_hit_is};
+use super::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
 use super::surface::{parametric_point, sphere_point};
 use super::texture::{sphere_uv, triangle_uv};
 use super::triangle::{
@@ -8,8 +8,8 @@ use super::triangle::{
 };
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
+    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec2, Vec3};
 
@@ -171,11 +171,22 @@ pub fn closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
 
 /// Whether the first thing `ray` meets is the primitive (`primitive`, `index`).
 pub fn first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u32) -> bool {
+    if primitive == PRIMITIVE_ENVIRONMENT {
+        return escapes(geometry, ray);
+    }
     if !geometry.bvh_nodes.is_empty() {
         return bvh_first_hit_is(geometry, ray, primitive, index);
     }
     let closest = closest_primitive(geometry, ray);
     closest.t != NO_HIT && closest.primitive == primitive && closest.index == index
+}
+
+/// Whether `ray` leaves the scene without hitting anything (it then sees the environment).
+pub fn escapes(geometry: &Geometry, ray: &Ray) -> bool {
+    if !geometry.bvh_nodes.is_empty() {
+        return bvh_escapes(geometry, ray);
+    }
+    closest_primitive(geometry, ray).t == NO_HIT
 }
 
 /// The nearest hit of `ray` among all primitives; `t == NO_HIT` when there is none.

@@ -1,13 +1,15 @@
 //! Light sampling for next-event estimation (WGSL side: `shaders/lights.wgsl`). An emitter is
 //! chosen in proportion to its power, then a direction towards it: quads and triangles by area, spheres by
-//! the cone of directions they subtend from outside, and by area from inside. All pdfs are per
+//! the cone of directions they subtend from outside, and by area from inside, the environment
+//! map by luminance (`environment.rs`). All pdfs are per
 //! unit solid angle at the shading point and include the selection probability.
 
+use super::environment::{environment_pdf, sample_environment};
 use super::material::{basis, PI};
 use super::rng::Rng;
 use super::trace::SceneRefs;
 use super::triangle::{triangle_normal, triangle_plane_distance, triangle_point};
-use crate::shader_types::{Sphere, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE};
+use crate::shader_types::{Sphere, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -77,6 +79,13 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
     let u = (rng.next_f32(), rng.next_f32());
     out.primitive = e.primitive;
     out.index = e.index;
+    if e.primitive == PRIMITIVE_ENVIRONMENT {
+        let s = sample_environment(scene, u, rng);
+        out.dir = s.dir;
+        out.pdf = e.probability * s.pdf;
+        out.radiance = s.radiance;
+        return out;
+    }
     if e.primitive == PRIMITIVE_TRIANGLE {
         // Uniform on the triangle's area.
         let tri = &scene.triangles[e.index as usize];
@@ -147,6 +156,9 @@ pub fn light_pdf(
     primitive: u32,
     index: u32,
 ) -> f32 {
+    if primitive == PRIMITIVE_ENVIRONMENT {
+        return scene.params.environment_light_probability * environment_pdf(scene, dir);
+    }
     if primitive == PRIMITIVE_TRIANGLE {
         let tri = &scene.triangles[index as usize];
         let normal = triangle_normal(tri);

@@ -6,6 +6,7 @@ pub mod accumulate;
 pub mod aov;
 pub mod bvh;
 pub mod camera;
+pub mod environment;
 pub mod intersect;
 pub mod lights;
 pub mod material;

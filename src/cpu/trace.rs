@@ -5,6 +5,7 @@ use super::aov::{
     aov_mean_add, aov_merge, aov_record_hit, aov_record_miss, aov_start, aovs_on, AovMean, PathAov,
 };
 use super::camera::camera_ray;
+use super::environment::environment_radiance;
 use super::intersect::{crosses_shading_side, first_hit_is, intersect_scene, Geometry, NO_HIT};
 use super::lights::{light_pdf, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
@@ -14,8 +15,8 @@ use super::texture::{material_at, Textures};
 use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, Material, Params, Quad, Sphere, Texture, Triangle, TriangleNormals,
-    TriangleUvs,
+    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Material, Params, Quad, Sphere, Texture,
+    Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
 };
 use glam::Vec3;
 
@@ -35,6 +36,9 @@ pub struct SceneRefs<'a> {
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
     pub triangle_uvs: &'a [TriangleUvs],
+    /// Empty without an environment map.
+    pub environment_texels: &'a [EnvironmentTexel],
+    pub environment_alias: &'a [EnvironmentAlias],
 }
 
 impl<'a> SceneRefs<'a> {
@@ -50,6 +54,8 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: &scene.triangle_normals,
             bvh_nodes: &scene.bvh_nodes,
             bvh_primitives: &scene.bvh_primitives,
+            environment_texels: &scene.environment_texels,
+            environment_alias: &scene.environment_alias,
             textures: &scene.textures,
             texels: &scene.texels,
             triangle_uvs: &scene.triangle_uvs,
@@ -138,14 +144,30 @@ pub fn path_step(
     let hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
-        if aovs_on(params) {
-            aov_record_miss(&mut path.aov, params);
+        // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
+        let mut escaped = Vec3::from(params.background);
+        if params.environment_width > 0 {
+            escaped = environment_radiance(scene, ray.dir);
         }
-        path.radiance += firefly_clamp(
-            params,
-            path.throughput * Vec3::from(params.background),
-            bounce,
-        );
+        if aovs_on(params) {
+            aov_record_miss(&mut path.aov, escaped);
+        }
+        if params.environment_width > 0 {
+            // The map is an emitter like the others: a BSDF-sampled ray that reaches it
+            // shares its light with next-event estimation from the previous vertex.
+            if light_sampling && !path.came_from_delta {
+                let pdf = light_pdf(
+                    scene,
+                    path.ray_start,
+                    ray.origin,
+                    ray.dir,
+                    PRIMITIVE_ENVIRONMENT,
+                    0,
+                );
+                escaped *= power_heuristic(path.bsdf_pdf_of_ray, pdf);
+            }
+        }
+        path.radiance += firefly_clamp(params, path.throughput * escaped, bounce);
         return true;
     }
     let m = &material_at(

@@ -191,6 +191,16 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.triangle_uvs),
                     read_only,
                 ),
+                BufferNeed::new(
+                    "environment map",
+                    array_bytes(&scene.environment_texels),
+                    read_only,
+                ),
+                BufferNeed::new(
+                    "environment alias table",
+                    array_bytes(&scene.environment_alias),
+                    read_only,
+                ),
                 BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
@@ -215,6 +225,9 @@ impl<'a> GpuRenderer<'a> {
         let textures = storage_buffer(ctx, "textures", &scene.textures);
         let texels = storage_buffer(ctx, "texture texels", &scene.texels);
         let triangle_uvs = storage_buffer(ctx, "triangle texture coordinates", &scene.triangle_uvs);
+        let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
+        let environment_alias =
+            storage_buffer(ctx, "environment alias table", &scene.environment_alias);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -274,6 +287,8 @@ impl<'a> GpuRenderer<'a> {
                 (20, read_only, &textures),
                 (21, read_only, &texels),
                 (22, read_only, &triangle_uvs),
+                (18, read_only, &environment_texels),
+                (19, read_only, &environment_alias),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

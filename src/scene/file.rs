@@ -62,6 +62,7 @@ pub(super) struct SceneToml {
     pub(super) quads: Vec<S<QuadToml>>,
     #[serde(default)]
     pub(super) meshes: Vec<S<MeshToml>>,
+    pub(super) environment: Option<S<EnvironmentToml>>,
 }
 
 #[derive(Deserialize)]
@@ -143,4 +144,15 @@ pub(super) struct MeshToml {
 pub(super) enum ScaleToml {
     Uniform(Real),
     PerAxis([Real; 3]),
+}
+
+/// `[environment]`: an equirectangular HDR image lighting the scene from every direction.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct EnvironmentToml {
+    /// Relative to the scene file's folder.
+    pub(super) file: S<String>,
+    pub(super) strength: Option<S<Real>>,
+    /// Degrees about the up (+y) axis.
+    pub(super) rotate: Option<S<Real>>,
 }

@@ -2,13 +2,16 @@
 //! that light sampling draws from.
 
 use super::bvh;
-use super::{CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
+use super::environment;
+use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
-    self, BvhNode, Emitter, Params, Texture, TriangleNormals, TriangleUvs, MATERIAL_DIELECTRIC,
-    MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
+    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_SPECULAR,
+    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    ROULETTE_OFF,
 };
+use glam::Vec3;
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
 #[derive(Clone, Debug)]
@@ -31,6 +34,9 @@ pub struct KernelScene {
     pub texels: Vec<[f32; 4]>,
     /// One per triangle when the scene has textures, else empty.
     pub triangle_uvs: Vec<TriangleUvs>,
+    /// The environment map's texels and alias table (`environment.rs`); empty without one.
+    pub environment_texels: Vec<EnvironmentTexel>,
+    pub environment_alias: Vec<EnvironmentAlias>,
 }
 
 impl KernelScene {
@@ -50,12 +56,36 @@ impl KernelScene {
             + bytes(&self.textures)
             + bytes(&self.texels)
             + bytes(&self.triangle_uvs)
+            + bytes(&self.environment_texels)
+            + bytes(&self.environment_alias)
     }
+}
+
+/// Writes `camera` into `params` for its image size (`params.width`, `params.height`): the
+/// basis precomputed, image-right and image-up scaled to half the viewport at unit distance,
+/// and the lens. Apart from the rest so the viewer can move the camera without rebuilding the
+/// scene's arrays (the BVH, the environment map's tables).
+pub fn place_camera(params: &mut Params, camera: &Camera) {
+    let CameraBasis {
+        w,
+        right: u,
+        image_up: v,
+    } = camera.basis();
+    let half_height = (camera.vfov.to_radians() * 0.5).tan();
+    let half_width = half_height * params.width as f32 / params.height as f32;
+    let lens_radius = 0.5 * camera.aperture;
+    params.eye = camera.eye.into();
+    params.forward = (-w).into();
+    params.right = (u * half_width).into();
+    params.up = (v * half_height).into();
+    params.lens_right = (u * lens_radius).into();
+    params.lens_up = (v * lens_radius).into();
+    params.focus_distance = camera.focus_distance;
 }
 
 impl Scene {
     /// [`Scene::try_kernel_scene`] for scenes known to fit the kernel (tests, the built-in
-    /// benchmark scene, the viewer); panics where that one returns an error.
+    /// benchmark scene); panics where that one returns an error.
     pub fn kernel_scene(&self) -> KernelScene {
         self.try_kernel_scene().unwrap_or_else(|e| panic!("{e}"))
     }
@@ -63,36 +93,24 @@ impl Scene {
     /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission ×
     /// strength, the BVH). Fails (bad input) when the BVH is deeper than the traversal stack.
     pub fn try_kernel_scene(&self) -> Result<KernelScene, InputError> {
-        let c = &self.camera;
         let r = &self.render;
-        let CameraBasis {
-            w,
-            right: u,
-            image_up: v,
-        } = c.basis();
-        let half_height = (c.vfov.to_radians() * 0.5).tan();
-        let half_width = half_height * r.width as f32 / r.height as f32;
-        let lens_radius = 0.5 * c.aperture;
+        let environment = self.environment.as_ref().map(|e| (e, e.tables()));
         let (
             emitters,
             sphere_light_probability,
             quad_light_probability,
             triangle_light_probability,
-        ) = self.emitter_table();
-        let params = Params {
-            eye: c.eye.into(),
+        ) = self.emitter_table(environment.as_ref().map(|(_, t)| t.radiance_integral));
+        let (environment_cos, environment_sin) = environment
+            .as_ref()
+            .map_or((1.0, 0.0), |(e, _)| e.rotation());
+        let mut params = Params {
             width: r.width,
-            forward: (-w).into(),
             height: r.height,
-            right: (u * half_width).into(),
             sample_start: 0,
-            up: (v * half_height).into(),
             sample_count: 0,
             background: r.background.into(),
             max_bounces: r.max_bounces,
-            lens_right: (u * lens_radius).into(),
-            focus_distance: c.focus_distance,
-            lens_up: (v * lens_radius).into(),
             light_sampling: r.light_sampling as u32,
             seed: r.seed,
             sphere_count: self.spheres.len() as u32,
@@ -108,9 +126,18 @@ impl Scene {
             aovs: 0,
             radiance_clamp: 0.0,
             triangle_count: self.triangles.len() as u32,
-            pad2: 0,
-            pad3: 0,
+            environment_width: environment.as_ref().map_or(0, |(e, _)| e.image.width),
+            environment_height: environment.as_ref().map_or(0, |(e, _)| e.image.height),
+            environment_cos,
+            environment_sin,
+            environment_light_probability: emitters
+                .iter()
+                .find(|e| e.primitive == PRIMITIVE_ENVIRONMENT)
+                .map_or(0.0, |e| e.probability),
+            pad4: 0,
+            ..Default::default()
         };
+        place_camera(&mut params, &self.camera);
         let spheres = self
             .spheres
             .iter()
@@ -223,7 +250,13 @@ impl Scene {
                     })
                     .collect()
             },
+            environment_texels: Vec::new(),
+            environment_alias: Vec::new(),
         };
+        if let Some((_, tables)) = environment {
+            scene.environment_texels = tables.texels;
+            scene.environment_alias = tables.alias;
+        }
         if bvh::wants_bvh(
             scene.spheres.len(),
             scene.quads.len(),
@@ -242,9 +275,14 @@ impl Scene {
 
     /// Every emitting primitive with its selection probability, proportional to its power
     /// (mean emitted radiance × area; the factor π is common to all), and that probability per
-    /// sphere, per quad and per triangle (0 for those that do not emit).
+    /// sphere, per quad and per triangle (0 for those that do not emit). The environment map,
+    /// given its ∫ L dω, emits that through a disc the size of the scene: π R² ∫ L dω, whose π
+    /// is dropped as for the others (pbrt's ImageInfiniteLight::Phi).
     #[allow(clippy::type_complexity)]
-    fn emitter_table(&self) -> (Vec<Emitter>, Vec<f32>, Vec<f32>, Vec<f32>) {
+    fn emitter_table(
+        &self,
+        environment_radiance_integral: Option<f64>,
+    ) -> (Vec<Emitter>, Vec<f32>, Vec<f32>, Vec<f32>) {
         let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
         let mut powers: Vec<(u32, u32, f64)> = Vec::new();
         for (i, s) in self.spheres.iter().enumerate() {
@@ -272,6 +310,30 @@ impl Scene {
                 powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }
         }
+        if let Some(integral) = environment_radiance_integral {
+            let points = self
+                .spheres
+                .iter()
+                .flat_map(|s| {
+                    [
+                        s.center - Vec3::splat(s.radius),
+                        s.center + Vec3::splat(s.radius),
+                    ]
+                })
+                .chain(self.quads.iter().flat_map(|q| {
+                    [
+                        q.corner,
+                        q.corner + q.u,
+                        q.corner + q.v,
+                        q.corner + q.u + q.v,
+                    ]
+                }))
+                .chain(self.triangles.iter().flat_map(|t| t.vertices));
+            let power = environment::scene_radius(points).powi(2) * integral;
+            if power > 0.0 {
+                powers.push((PRIMITIVE_ENVIRONMENT, 0, power));
+            }
+        }
         let total: f64 = powers.iter().map(|p| p.2).sum();
         let mut cumulative = 0.0;
         let mut emitters: Vec<Emitter> = powers
@@ -296,7 +358,8 @@ impl Scene {
             let per_primitive = match e.primitive {
                 PRIMITIVE_SPHERE => &mut sphere_probability,
                 PRIMITIVE_QUAD => &mut quad_probability,
-                _ => &mut triangle_probability,
+                PRIMITIVE_TRIANGLE => &mut triangle_probability,
+                _ => continue,
             };
             per_primitive[e.index as usize] = e.probability;
         }

@@ -8,6 +8,7 @@
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
 pub mod bvh;
+pub mod environment;
 mod file;
 pub mod image;
 mod kernel;
@@ -17,7 +18,7 @@ pub mod stress;
 pub mod texture;
 mod validate;
 
-pub use kernel::KernelScene;
+pub use kernel::{place_camera, KernelScene};
 
 use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
@@ -77,6 +78,8 @@ pub struct Scene {
     pub triangles: Vec<Triangle>,
     /// The textures materials refer to.
     pub textures: texture::TextureSet,
+    /// `[environment]`: lights the scene in place of `render.background`.
+    pub environment: Option<environment::Environment>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,8 @@
 //! From the file as written to a validated [`Scene`]: every range, reference and degenerate
 //! case checked, each failure tied to its field and its place in the file.
 
-use super::file::{Real, RoughnessToml, ScaleToml, SceneToml, Triple, S};
+use super::environment::{self, Environment};
+use super::file::{EnvironmentToml, Real, RoughnessToml, ScaleToml, SceneToml, Triple, S};
 use super::limits::{MAX_COORDINATE, MAX_IOR, MAX_RADIANCE, MIN_IOR, MIN_LENGTH, MIN_SINE};
 use super::mesh::{self, MeshTransform};
 use super::texture::{TextureSet, TextureUse};
@@ -166,6 +167,62 @@ fn int_in(x: &S<i64>, field: &str, min: i64, max: i64) -> Result<u32, FieldError
     check_range(*x.get_ref(), min, max)
         .map(|_| *x.get_ref() as u32)
         .or_else(|m| fail(x.span(), field, m))
+}
+
+/// `[environment]`: the map read relative to `folder`, its strength and rotation in range.
+fn validate_environment(
+    e: &S<EnvironmentToml>,
+    has_background: bool,
+    folder: &Path,
+) -> Result<Environment, FieldError> {
+    if has_background {
+        return fail(
+            e.span(),
+            "environment",
+            "give either render.background (a constant colour) or [environment] (a map), not both",
+        );
+    }
+    let e_span = e.span();
+    let e = e.get_ref();
+    let strength = match &e.strength {
+        Some(s) => {
+            let v = real(s, "environment.strength")?;
+            if !(0.0..=MAX_RADIANCE as f32).contains(&v) {
+                return fail(
+                    s.span(),
+                    "environment.strength",
+                    format!("must be in [0, {MAX_RADIANCE:e}], got {v}"),
+                );
+            }
+            v
+        }
+        None => 1.0,
+    };
+    let rotate = match &e.rotate {
+        Some(r) => {
+            let v = real(r, "environment.rotate")?;
+            if v.abs() > 360.0 {
+                return fail(
+                    r.span(),
+                    "environment.rotate",
+                    format!("must be in [-360, 360] degrees, got {v}"),
+                );
+            }
+            v
+        }
+        None => 0.0,
+    };
+    let file = e.file.get_ref();
+    if file.is_empty() {
+        return fail(e_span, "environment.file", "must name an image file");
+    }
+    environment::load(&folder.join(file), strength, rotate).or_else(|message| {
+        fail(
+            e.file.span(),
+            "environment.file",
+            format!("{file}: {message}"),
+        )
+    })
 }
 
 impl SceneToml {
@@ -601,6 +658,14 @@ impl SceneToml {
                 );
             }
         }
+        let environment = match &self.environment {
+            Some(e) => Some(validate_environment(
+                e,
+                render.background.is_some(),
+                folder,
+            )?),
+            None => None,
+        };
         let scene = Scene {
             name,
             camera: Camera {
@@ -626,6 +691,7 @@ impl SceneToml {
             quads,
             triangles,
             textures,
+            environment,
         };
         Ok((scene, warnings))
     }

@@ -34,6 +34,8 @@ pub enum Action {
     SavePng,
     /// Save the linear mean radiance as an EXR.
     SaveExr,
+    /// Turn denoising of the shown image on or off (D).
+    Denoise,
     /// Re-read the scene file now.
     Reload,
     /// Ask the window system for a new inner size (tests: the same path as a user resize).
@@ -41,6 +43,9 @@ pub enum Action {
         width: u32,
         height: u32,
     },
+    /// Tests only: block until the running background denoise finishes (at most 60 s), so a
+    /// test sees a denoised image land at a known frame.
+    WaitForDenoise,
     /// Tests only: block until the scene file changes (at most 60 s), so a test can edit the
     /// file at a known frame instead of racing the frame counter.
     WaitForEdit,
@@ -132,6 +137,8 @@ fn parse_action(command: &str) -> Result<Action, String> {
         "save-exr" => Action::SaveExr,
         "reload" => Action::Reload,
         "wait-edit" => Action::WaitForEdit,
+        "denoise" => Action::Denoise,
+        "wait-denoised" => Action::WaitForDenoise,
         "quit" => Action::Quit,
         _ => return Err(format!("unknown action {name:?}")),
     })
@@ -152,6 +159,10 @@ mod tests {
         assert_eq!(s.take(5), vec![], "taken actions are gone");
         assert_eq!(s.take(10), vec![Action::Reload]);
         assert_eq!(s.take(12), vec![Action::Quit]);
+        assert_eq!(
+            Script::parse("0:denoise; 0:wait-denoised").unwrap().take(0),
+            vec![Action::Denoise, Action::WaitForDenoise]
+        );
         assert_eq!(
             Script::parse("1:fly 0 0 0.5; 2:resize 64 32; 3:exposure -1")
                 .unwrap()

@@ -3,6 +3,7 @@
 
 use super::action::{Action, Script};
 use super::camera_control;
+use super::denoised::{DenoisedView, Snapshot, Update};
 use super::display::DisplayPass;
 use super::input::InputState;
 use super::watch::{BackgroundLoad, FileWatch};
@@ -11,8 +12,11 @@ use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::{Image, ImageFormat};
 use crate::render::{BatchSizer, Renderer};
 use crate::scene::{
-    Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS, MAX_SPP,
+    place_camera, Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS,
+    MAX_SPP,
 };
+use crate::shader_types::Params;
+use crate::tonemap::{DisplayTransform, Tonemap};
 use anyhow::{anyhow, Context, Result};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -31,10 +35,16 @@ const EXPOSURE_LIMIT: f32 = 20.0;
 /// How long the test-only `wait-edit` action waits for the scene file to change.
 const WAIT_FOR_EDIT_LIMIT: Duration = Duration::from_secs(60);
 
-pub fn run(event_loop: EventLoop<()>, scene: Scene, mut options: ViewOptions) -> Result<()> {
+pub fn run(
+    event_loop: EventLoop<()>,
+    scene: Scene,
+    kernel: KernelScene,
+    mut options: ViewOptions,
+) -> Result<()> {
     // Progressive rendering never idles: the image refines while nothing happens.
     event_loop.set_control_flow(ControlFlow::Poll);
     let script = std::mem::take(&mut options.script);
+    let display = options.display;
     let mut app = App {
         watch: FileWatch::new(&options.scene),
         loader: BackgroundLoad::new(&options.scene),
@@ -42,11 +52,16 @@ pub fn run(event_loop: EventLoop<()>, scene: Scene, mut options: ViewOptions) ->
         file_camera: scene.camera.clone(),
         camera: scene.camera.clone(),
         scene,
+        kernel,
         options,
         script,
         camera_moved: false,
         restarted: true,
-        exposure: 0.0,
+        display,
+        aovs: false,
+        denoised: DenoisedView::default(),
+        generation: 0,
+        denoise_note: None,
         input: InputState::default(),
         gpu: None,
         pending_size: None,
@@ -71,6 +86,10 @@ struct Gpu {
     ctx: &'static GpuContext,
     renderer: GpuRenderer<'static>,
     display: DisplayPass,
+    /// The denoised image, uploaded for the display pass (per pixel vec4s).
+    denoised_buffer: Option<wgpu::Buffer>,
+    /// Whether the display pass reads `denoised_buffer` (else the renderer's mean).
+    showing_denoised: bool,
 }
 
 struct App {
@@ -78,6 +97,8 @@ struct App {
     script: Script,
     /// The last scene that loaded, its image size set to the window's.
     scene: Scene,
+    /// `scene` as the kernel reads it, with the camera the file gives (see [`App::params`]).
+    kernel: KernelScene,
     /// The camera the scene file says; a reload adopts the file's camera only if it changed,
     /// so editing a material does not throw away where the user flew to.
     file_camera: Camera,
@@ -85,7 +106,16 @@ struct App {
     camera_moved: bool,
     /// The accumulation restarted: the next frame is a 1-spp preview.
     restarted: bool,
-    exposure: f32,
+    /// The tone curve and the exposure (which + and - change).
+    display: DisplayTransform,
+    /// The kernel accumulates the denoiser's AOVs: from the first D on (turning them off again
+    /// would compile another kernel and restart for nothing).
+    aovs: bool,
+    denoised: DenoisedView,
+    /// Counts the accumulation's restarts, so a denoise of an older one is known as stale.
+    generation: u64,
+    /// Why D cannot denoise, for the title, once it was pressed without OIDN.
+    denoise_note: Option<String>,
     sizer: BatchSizer,
     input: InputState,
     watch: FileWatch,
@@ -166,11 +196,78 @@ impl App {
         (self.scene.render.width, self.scene.render.height)
     }
 
+    /// The kernel's parameters for the current camera, image size and AOVs.
+    fn params(&self) -> Params {
+        let mut params = self.kernel.params;
+        place_camera(&mut params, &self.camera);
+        params.aovs = self.aovs as u32;
+        params
+    }
+
     /// The kernel's view of the current scene and camera.
     fn kernel_scene(&self) -> KernelScene {
-        let mut scene = self.scene.clone();
-        scene.camera = self.camera.clone();
-        scene.kernel_scene()
+        KernelScene {
+            params: self.params(),
+            ..self.kernel.clone()
+        }
+    }
+
+    /// Turns denoising on or off (D); without OIDN, says why once and shows the raw image.
+    fn toggle_denoise(&mut self) -> Result<()> {
+        match self.denoised.toggle() {
+            Ok(on) => {
+                if on && !self.aovs {
+                    // The albedo and normal guides are accumulated from the start on.
+                    self.aovs = true;
+                    self.rebuild_renderer()?;
+                }
+                self.log(json!({"event": "denoise", "on": on, "frame": self.frame}));
+            }
+            Err(e) => {
+                if self.denoise_note.is_none() {
+                    crate::errln!("glint view: D shows the raw image: {e:#}");
+                    self.denoise_note = Some("no denoiser, see stderr".into());
+                }
+                self.log(json!({"event": "denoise", "on": false, "frame": self.frame, "error": format!("{e:#}")}));
+            }
+        }
+        self.title.since -= TITLE_INTERVAL;
+        Ok(())
+    }
+
+    /// Shows a finished denoise, or notes why not.
+    fn take_denoised(&mut self, update: Update) {
+        match update {
+            Update::Nothing => {}
+            Update::Show(denoised) => {
+                if let Some(gpu) = self.gpu.as_mut() {
+                    upload_denoised(gpu, &denoised.image);
+                }
+                self.log(json!({
+                    "event": "denoised",
+                    "frame": self.frame,
+                    "spp": denoised.snapshot.spp,
+                    "seconds": denoised.seconds,
+                }));
+            }
+            Update::Stale(snapshot) => self.log(
+                json!({"event": "denoise-discarded", "frame": self.frame, "spp": snapshot.spp}),
+            ),
+            Update::Failed(e) => {
+                crate::errln!("glint view: denoising failed, showing the raw image: {e:#}");
+                self.denoise_note = Some("denoising failed, see stderr".into());
+                self.log(json!({"event": "denoise", "on": false, "frame": self.frame, "error": format!("{e:#}")}));
+                self.title.since -= TITLE_INTERVAL;
+            }
+        }
+    }
+
+    /// Which accumulation the renderer holds now.
+    fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            generation: self.generation,
+            spp: self.gpu.as_ref().map_or(0, |g| g.renderer.samples()),
+        }
     }
 
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
@@ -223,7 +320,7 @@ impl App {
         let mut display = DisplayPass::new(&ctx.device, format);
         display.bind(&ctx.device, renderer.mean_buffer());
         crate::errln!(
-            "glint view: {} on {} ({:?}, {:?}); drag to orbit, right-drag to pan, wheel to dolly, WASDQE to fly",
+            "glint view: {} on {} ({:?}, {:?}); drag to orbit, right-drag to pan, wheel to dolly, arrow keys and Q/E to fly, D to denoise",
             self.options.scene.display(),
             ctx.device_name(),
             format,
@@ -237,6 +334,8 @@ impl App {
             ctx,
             renderer,
             display,
+            denoised_buffer: None,
+            showing_denoised: false,
         });
         // The window manager may not grant the size asked for; the image follows the window.
         self.pending_size = Some(size);
@@ -252,6 +351,7 @@ impl App {
         gpu.renderer = GpuRenderer::new(gpu.ctx, &kernel_scene)?;
         gpu.display
             .bind(&gpu.ctx.device, gpu.renderer.mean_buffer());
+        gpu.showing_denoised = false;
         self.camera_moved = false;
         self.restarted = true;
         Ok(())
@@ -283,7 +383,13 @@ impl App {
                 self.restarted = true;
             }
             Action::Exposure { stops } => {
-                self.exposure = (self.exposure + stops).clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
+                self.display.exposure =
+                    (self.display.exposure + stops).clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
+            }
+            Action::Denoise => self.toggle_denoise()?,
+            Action::WaitForDenoise => {
+                let update = self.denoised.wait(self.snapshot(), WAIT_FOR_EDIT_LIMIT);
+                self.take_denoised(update);
             }
             Action::SavePng => {
                 let path = next_free_name(&self.options.scene, "png");
@@ -339,7 +445,12 @@ impl App {
                     height: Some(height),
                     ..Default::default()
                 })
-                .map_err(|m| (format!("{}: {m}", path.display()), String::new())),
+                .map_err(|m| format!("{}: {m}", path.display()))
+                .and_then(|scene| {
+                    let kernel = scene.try_kernel_scene().map_err(|e| e.to_string())?;
+                    Ok((scene, kernel))
+                })
+                .map_err(|message| (message, String::new())),
             Err(e) => {
                 let at = e
                     .position
@@ -357,12 +468,13 @@ impl App {
                 self.scene_error = Some(format!("scene error{at}, see stderr"));
                 self.title.since -= TITLE_INTERVAL;
             }
-            Ok(scene) => {
+            Ok((scene, kernel)) => {
                 if scene.camera != self.file_camera {
                     self.file_camera = scene.camera.clone();
                     self.camera = scene.camera.clone();
                 }
                 self.scene = scene;
+                self.kernel = kernel;
                 self.rebuild_renderer()?;
                 if self.scene_error.take().is_some() {
                     crate::errln!("glint: {} reloaded", path.display());
@@ -374,19 +486,22 @@ impl App {
         Ok(())
     }
 
-    /// PNG: what is shown (mean × 2^exposure, clamped, sRGB). EXR: the linear mean radiance,
-    /// as `glint render` writes it.
+    /// PNG: what is shown (the mean, or with D on the denoised image of all samples so far,
+    /// through the tone curve, sRGB). EXR: the linear mean radiance, as `glint render` writes it.
     fn save(&mut self, path: &Path) -> Result<()> {
+        let current = self.snapshot();
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
-        let mut image: Image = gpu.renderer.read_mean()?;
-        if ImageFormat::from_path(path).map_err(anyhow::Error::msg)? == ImageFormat::Png {
-            let scale = self.exposure.exp2();
-            for p in &mut image.pixels {
-                *p = p.map(|v| v * scale);
-            }
-        }
+        let png = ImageFormat::from_path(path).map_err(anyhow::Error::msg)? == ImageFormat::Png;
+        let image: Image = if png && self.denoised.is_on() {
+            let denoised = self.denoised.denoise_now(&mut gpu.renderer, current)?;
+            self.display.image(&denoised)
+        } else if png {
+            self.display.image(&gpu.renderer.read_mean()?)
+        } else {
+            gpu.renderer.read_mean()?
+        };
         image
             .write(path)
             .with_context(|| format!("writing {}", path.display()))?;
@@ -440,6 +555,9 @@ impl App {
                 ..Default::default()
             })
             .map_err(|m| anyhow!("cannot render at {width}×{height}: {m}"))?;
+        // Only the image size changed: the camera's parameters follow it in params().
+        self.kernel.params.width = width;
+        self.kernel.params.height = height;
         self.rebuild_renderer()?;
         self.log(json!({"event": "resize", "width": width, "height": height, "frame": self.frame}));
         Ok(())
@@ -471,8 +589,7 @@ impl App {
             self.pending_size = None;
             self.apply_resize(size)?;
         }
-        let moved_params =
-            std::mem::take(&mut self.camera_moved).then(|| self.kernel_scene().params);
+        let moved_params = std::mem::take(&mut self.camera_moved).then(|| self.params());
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
@@ -482,6 +599,9 @@ impl App {
         }
         // Right after a restart, show something at once, whatever the batch size.
         let preview = std::mem::take(&mut self.restarted);
+        if preview {
+            self.generation += 1;
+        }
         let wanted = if preview {
             1
         } else {
@@ -499,8 +619,19 @@ impl App {
         if !preview && spp > 0 && self.options.spp_per_frame.is_none() {
             self.sizer.update(spp, batch_time);
         }
+        let current = Snapshot {
+            generation: self.generation,
+            spp: gpu.renderer.samples(),
+        };
+        let update = self.denoised.update(&mut gpu.renderer, current)?;
+        self.take_denoised(update);
+        let Some(gpu) = self.gpu.as_mut() else {
+            return Ok(());
+        };
+        let denoised = self.denoised.shown().is_some();
+        show_denoised(gpu, denoised);
         let image_size = (self.scene.render.width, self.scene.render.height);
-        present(gpu, image_size, self.exposure)?;
+        present(gpu, image_size, &self.display)?;
         let total_spp = gpu.renderer.samples();
         let frame_time = start.elapsed();
         let paths = spp as u64 * image_size.0 as u64 * image_size.1 as u64;
@@ -514,6 +645,7 @@ impl App {
             "width": image_size.0,
             "height": image_size.1,
             "restarted": preview,
+            "denoised": denoised,
         }));
         self.title.paths += paths;
         self.title.frames += 1;
@@ -542,23 +674,78 @@ impl App {
                 .unwrap_or_default(),
             self.title.paths as f64 / secs / 1e6,
             secs * 1e3 / self.title.frames as f64,
-            self.exposure
+            self.display.exposure
         );
-        if let Some(note) = &self.scene_error {
+        if self.display.tonemap != Tonemap::Clamp {
+            title += &format!(" · {:?}", self.display.tonemap).to_lowercase();
+        }
+        if self.denoised.is_on() {
+            title += " · denoised";
+            if let Some(shown) = self.denoised.shown() {
+                title += &format!(" ({} spp)", shown.spp);
+            }
+        }
+        for note in [&self.scene_error, &self.denoise_note]
+            .into_iter()
+            .flatten()
+        {
             title += &format!(" · {note}");
         }
         gpu.window.set_title(&title);
+        self.log(json!({"event": "title", "title": title}));
         self.title = TitleStats::new();
     }
 }
 
-/// Shows the mean on the window; a frame the surface cannot take now is skipped.
-fn present(gpu: &mut Gpu, image_size: (u32, u32), exposure: f32) -> Result<()> {
+/// Binds the denoised image to the display pass, or the mean, when that changes.
+fn show_denoised(gpu: &mut Gpu, denoised: bool) {
+    if denoised == gpu.showing_denoised {
+        return;
+    }
+    let buffer = match (&gpu.denoised_buffer, denoised) {
+        (Some(buffer), true) => buffer,
+        _ => gpu.renderer.mean_buffer(),
+    };
+    gpu.display.bind(&gpu.ctx.device, buffer);
+    gpu.showing_denoised = denoised && gpu.denoised_buffer.is_some();
+}
+
+/// Copies a denoised image to the GPU for the display pass.
+fn upload_denoised(gpu: &mut Gpu, image: &Image) {
+    let vec4s: Vec<[f32; 4]> = image
+        .pixels
+        .iter()
+        .map(|p| [p[0], p[1], p[2], 0.0])
+        .collect();
+    let size = size_of_val(vec4s.as_slice()) as u64;
+    if gpu
+        .denoised_buffer
+        .as_ref()
+        .is_none_or(|b| b.size() != size)
+    {
+        gpu.denoised_buffer = Some(gpu.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("denoised"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }));
+        // A new buffer must be bound anew.
+        gpu.showing_denoised = false;
+    }
+    if let Some(buffer) = &gpu.denoised_buffer {
+        gpu.ctx
+            .queue
+            .write_buffer(buffer, 0, bytemuck::cast_slice(&vec4s));
+    }
+}
+
+/// Shows the bound image on the window; a frame the surface cannot take now is skipped.
+fn present(gpu: &mut Gpu, image_size: (u32, u32), display: &DisplayTransform) -> Result<()> {
     let texture = match gpu.surface.get_current_texture() {
         wgpu::CurrentSurfaceTexture::Success(t) => t,
         wgpu::CurrentSurfaceTexture::Suboptimal(t) => {
             // Show this one; configure anew before the next.
-            draw(gpu, t, image_size, exposure);
+            draw(gpu, t, image_size, display);
             gpu.surface.configure(&gpu.ctx.device, &gpu.config);
             return Ok(());
         }
@@ -582,11 +769,16 @@ fn present(gpu: &mut Gpu, image_size: (u32, u32), exposure: f32) -> Result<()> {
             return Err(anyhow!("cannot get the window's next image: {error}"));
         }
     };
-    draw(gpu, texture, image_size, exposure);
+    draw(gpu, texture, image_size, display);
     Ok(())
 }
 
-fn draw(gpu: &Gpu, texture: wgpu::SurfaceTexture, image_size: (u32, u32), exposure: f32) {
+fn draw(
+    gpu: &Gpu,
+    texture: wgpu::SurfaceTexture,
+    image_size: (u32, u32),
+    display: &DisplayTransform,
+) {
     let view = texture.texture.create_view(&Default::default());
     let mut encoder = gpu.ctx.device.create_command_encoder(&Default::default());
     gpu.display.draw(
@@ -595,7 +787,7 @@ fn draw(gpu: &Gpu, texture: wgpu::SurfaceTexture, image_size: (u32, u32), exposu
         &view,
         image_size,
         (gpu.config.width, gpu.config.height),
-        exposure,
+        display,
     );
     gpu.ctx.queue.submit([encoder.finish()]);
     gpu.window.pre_present_notify();

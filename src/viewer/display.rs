@@ -1,10 +1,16 @@
-//! The display pass: shows a renderer's running mean on a surface (`shaders/display.wgsl`).
-//! It reads the mean buffer where the kernel wrote it, so showing a frame costs no readback.
+//! The display pass: shows a renderer's running mean (or the denoised image) on a surface,
+//! through the tone curve (`shaders/display.wgsl`, `shaders/tonemap.wgsl`). It reads the mean
+//! buffer where the kernel wrote it, so showing a frame costs no readback.
 
 use crate::gpu::binding::buffer_layout_entry;
+use crate::tonemap::{DisplayTransform, Tonemap};
 use bytemuck::{Pod, Zeroable};
 
-pub const DISPLAY_SHADER: &str = include_str!("../../shaders/display.wgsl");
+/// The tone curves (src/tonemap.rs's GPU mirror), then the pass that uses them.
+pub const DISPLAY_SHADER: &str = concat!(
+    include_str!("../../shaders/tonemap.wgsl"),
+    include_str!("../../shaders/display.wgsl")
+);
 pub const VERTEX_ENTRY_POINT: &str = "vs_main";
 pub const FRAGMENT_ENTRY_POINT: &str = "fs_main";
 
@@ -16,7 +22,18 @@ pub struct DisplayUniform {
     pub target_size: [u32; 2],
     pub scale: f32,
     pub encode_srgb: u32,
-    pub pad: [u32; 2],
+    /// [`tonemap_code`] of the curve.
+    pub tonemap: u32,
+    pub pad: u32,
+}
+
+/// The shader's code for `tonemap` (`TONEMAP_*` in shaders/tonemap.wgsl).
+pub fn tonemap_code(tonemap: Tonemap) -> u32 {
+    match tonemap {
+        Tonemap::Clamp => 0,
+        Tonemap::Aces => 1,
+        Tonemap::Agx => 2,
+    }
 }
 
 pub struct DisplayPass {
@@ -95,7 +112,8 @@ impl DisplayPass {
         }
     }
 
-    /// Shows `mean` from now on: call it whenever the renderer (and so its buffer) changes.
+    /// Shows `mean` (per pixel vec4s of linear radiance) from now on: call it whenever the
+    /// renderer (and so its buffer) changes, or to switch between the raw and denoised images.
     pub fn bind(&mut self, device: &wgpu::Device, mean: &wgpu::Buffer) {
         self.bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display"),
@@ -113,8 +131,8 @@ impl DisplayPass {
         }));
     }
 
-    /// Records the pass: the bound mean of an `image_size` image, times 2^`exposure`, drawn
-    /// over all of `target` (of `target_size`).
+    /// Records the pass: the bound image of `image_size`, shown through `transform` (as a PNG
+    /// would hold it), drawn over all of `target` (of `target_size`).
     pub fn draw(
         &self,
         queue: &wgpu::Queue,
@@ -122,7 +140,7 @@ impl DisplayPass {
         target: &wgpu::TextureView,
         image_size: (u32, u32),
         target_size: (u32, u32),
-        exposure: f32,
+        transform: &DisplayTransform,
     ) {
         let Some(bind_group) = &self.bind_group else {
             return;
@@ -130,9 +148,10 @@ impl DisplayPass {
         let uniform = DisplayUniform {
             image_size: [image_size.0, image_size.1],
             target_size: [target_size.0.max(1), target_size.1.max(1)],
-            scale: exposure.exp2(),
+            scale: transform.exposure.exp2(),
             encode_srgb: self.encode_srgb as u32,
-            pad: [0; 2],
+            tonemap: tonemap_code(transform.tonemap),
+            pad: 0,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

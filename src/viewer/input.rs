@@ -70,8 +70,9 @@ impl InputState {
         (steps != 0.0 && steps.is_finite()).then_some(Action::Dolly { steps })
     }
 
-    /// A key press or release. Fly keys go by their physical position (WASD on any layout);
-    /// the others by the character they type. Returns the action of a press, if any.
+    /// A key press or release. Fly keys go by their physical position (the arrow keys, and Q
+    /// and E where they are on a QWERTY keyboard, on any layout); the others by the character
+    /// they type. Returns the action of a press, if any.
     pub fn key(
         &mut self,
         physical: PhysicalKey,
@@ -79,11 +80,13 @@ impl InputState {
         state: ElementState,
         repeat: bool,
     ) -> Option<Action> {
+        // Not WASD: D is the denoiser's key (issue 12), and a WASD without D would send a
+        // user's right hand to it; the arrow keys are what every viewer flies with besides.
         let fly = match physical {
-            PhysicalKey::Code(KeyCode::KeyW) => Some(FlyKey::Forward),
-            PhysicalKey::Code(KeyCode::KeyS) => Some(FlyKey::Back),
-            PhysicalKey::Code(KeyCode::KeyA) => Some(FlyKey::Left),
-            PhysicalKey::Code(KeyCode::KeyD) => Some(FlyKey::Right),
+            PhysicalKey::Code(KeyCode::ArrowUp) => Some(FlyKey::Forward),
+            PhysicalKey::Code(KeyCode::ArrowDown) => Some(FlyKey::Back),
+            PhysicalKey::Code(KeyCode::ArrowLeft) => Some(FlyKey::Left),
+            PhysicalKey::Code(KeyCode::ArrowRight) => Some(FlyKey::Right),
             PhysicalKey::Code(KeyCode::KeyQ) => Some(FlyKey::Down),
             PhysicalKey::Code(KeyCode::KeyE) => Some(FlyKey::Up),
             _ => None,
@@ -116,6 +119,7 @@ impl InputState {
                 "r" | "R" if !repeat => Some(Action::Restart),
                 "p" | "P" if !repeat => Some(Action::SavePng),
                 "x" | "X" if !repeat => Some(Action::SaveExr),
+                "d" | "D" if !repeat => Some(Action::Denoise),
                 _ => None,
             },
             _ => None,
@@ -169,6 +173,16 @@ mod tests {
         )
     }
 
+    fn arrow(s: &mut InputState, code: KeyCode, state: ElementState) -> Option<Action> {
+        let name = match code {
+            KeyCode::ArrowUp => NamedKey::ArrowUp,
+            KeyCode::ArrowDown => NamedKey::ArrowDown,
+            KeyCode::ArrowLeft => NamedKey::ArrowLeft,
+            _ => NamedKey::ArrowRight,
+        };
+        s.key(PhysicalKey::Code(code), &Key::Named(name), state, false)
+    }
+
     #[test]
     fn drags_orbit_with_the_left_button_and_pan_with_the_others() {
         let mut s = InputState::default();
@@ -209,8 +223,8 @@ mod tests {
     fn held_fly_keys_give_one_step_per_frame() {
         let mut s = InputState::default();
         assert_eq!(s.fly_step(Duration::from_millis(20)), None);
-        key(&mut s, KeyCode::KeyW, "w", PRESS);
-        key(&mut s, KeyCode::KeyD, "d", PRESS);
+        assert_eq!(arrow(&mut s, KeyCode::ArrowUp, PRESS), None);
+        assert_eq!(arrow(&mut s, KeyCode::ArrowRight, PRESS), None);
         key(&mut s, KeyCode::KeyE, "e", PRESS);
         key(&mut s, KeyCode::KeyQ, "q", PRESS);
         let Some(Action::Fly { right, up, forward }) = s.fly_step(Duration::from_millis(20)) else {
@@ -218,8 +232,8 @@ mod tests {
         };
         assert_eq!((right, up), (0.01, 0.0));
         assert_eq!(forward, 0.01);
-        key(&mut s, KeyCode::KeyW, "w", RELEASE);
-        key(&mut s, KeyCode::KeyD, "d", RELEASE);
+        arrow(&mut s, KeyCode::ArrowUp, RELEASE);
+        arrow(&mut s, KeyCode::ArrowRight, RELEASE);
         key(&mut s, KeyCode::KeyE, "e", RELEASE);
         assert!(matches!(
             s.fly_step(Duration::from_secs(5)),
@@ -227,6 +241,16 @@ mod tests {
         ));
         s.focus_lost();
         assert_eq!(s.fly_step(Duration::from_millis(20)), None);
+        arrow(&mut s, KeyCode::ArrowLeft, PRESS);
+        arrow(&mut s, KeyCode::ArrowDown, PRESS);
+        assert_eq!(
+            s.fly_step(Duration::from_millis(20)),
+            Some(Action::Fly {
+                right: -0.01,
+                up: 0.0,
+                forward: -0.01
+            })
+        );
     }
 
     #[test]
@@ -245,6 +269,13 @@ mod tests {
             key(&mut s, KeyCode::KeyX, "x", PRESS),
             Some(Action::SaveExr)
         );
+        // D denoises; it is no fly key (fly right is the right arrow).
+        assert_eq!(
+            key(&mut s, KeyCode::KeyD, "d", PRESS),
+            Some(Action::Denoise)
+        );
+        assert_eq!(s.fly_step(Duration::from_millis(20)), None);
+        assert_eq!(key(&mut s, KeyCode::KeyD, "d", RELEASE), None);
         assert_eq!(
             key(&mut s, KeyCode::Equal, "=", PRESS),
             Some(Action::Exposure { stops: 0.5 })

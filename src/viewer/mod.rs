@@ -3,12 +3,14 @@
 //! display pass; input moves the camera and restarts the accumulation.
 //!
 //! Parts: [`action`] (what input asks for), [`input`] (winit events → actions),
-//! [`camera_control`] (the camera math), [`display`] (the display pass), [`watch`] (scene
-//! file edits), [`app`] (the winit application that ties them together).
+//! [`camera_control`] (the camera math), [`display`] (the display pass), [`denoised`] (the
+//! D key's background denoising), [`watch`] (scene file edits), [`app`] (the winit
+//! application that ties them together).
 
 pub mod action;
 mod app;
 pub mod camera_control;
+pub mod denoised;
 pub mod display;
 pub mod input;
 pub mod watch;
@@ -16,6 +18,7 @@ pub mod watch;
 use crate::error::InputError;
 use crate::output_check::OutputSet;
 use crate::scene::{RenderOverrides, Scene};
+use crate::tonemap::DisplayTransform;
 use action::Script;
 use anyhow::Result;
 use std::path::PathBuf;
@@ -32,6 +35,9 @@ pub struct ViewOptions {
     pub frames: Option<u64>,
     /// Written on exit: PNG = what is shown, EXR = the linear mean.
     pub screenshot: Option<PathBuf>,
+    /// The tone curve and the starting exposure (`--tonemap`, `--exposure`; keys change the
+    /// exposure).
+    pub display: DisplayTransform,
     /// Actions injected before given frames (tests).
     pub script: Script,
     /// One JSON line per frame and per event on stdout (tests, measurements).
@@ -74,10 +80,13 @@ pub fn run(options: ViewOptions) -> Result<()> {
         ))
         .into());
     }
+    // Built once here (the BVH, the environment map's tables), and again only when the scene
+    // file changes; a camera move rewrites the camera's parameters alone.
+    let kernel = scene.try_kernel_scene()?;
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| {
         InputError(format!(
             "no display: glint view cannot connect to the window system ({e}); {NO_DISPLAY_HINT}"
         ))
     })?;
-    app::run(event_loop, scene, options)
+    app::run(event_loop, scene, kernel, options)
 }

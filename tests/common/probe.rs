@@ -63,6 +63,8 @@ pub fn run_probe(
     let textures = storage_buffer(ctx, "textures", &scene.textures);
     let texels = storage_buffer(ctx, "texels", &scene.texels);
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
+    let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
+    let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -97,6 +99,8 @@ pub fn run_probe(
             (20, read_only, &textures),
             (21, read_only, &texels),
             (22, read_only, &triangle_uvs),
+            (18, read_only, &environment_texels),
+            (19, read_only, &environment_alias),
         ],
     );
     let pipeline = compute_pipeline(device, entry, &layout, &module, entry);
