@@ -65,8 +65,9 @@ const NO_PRIMITIVE: u32 = 0xffffffffu;
 fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
     var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u);
     var found = false;
+    // Node indices only: a popped node's entry distance is recomputed (the same arithmetic,
+    // so the same decision), which halves the per-lane stack lavapipe keeps in memory.
     var stack: array<u32, BVH_STACK_SIZE>;
-    var stack_t: array<f32, BVH_STACK_SIZE>;
     var top = 0u;
     var node_index = 0u;
     if hit_box(bvh_nodes[0], r, best.t) == NO_HIT {
@@ -93,7 +94,6 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
             if t_left != NO_HIT && t_right != NO_HIT {
                 let left_first = t_left <= t_right;
                 stack[top] = select(left, left + 1u, left_first);
-                stack_t[top] = select(t_left, t_right, left_first);
                 top += 1u;
                 node_index = select(left + 1u, left, left_first);
                 continue;
@@ -111,7 +111,7 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
         var popped = false;
         while top > 0u {
             top -= 1u;
-            if stack_t[top] <= widened(best.t) {
+            if hit_box(bvh_nodes[stack[top]], r, best.t) != NO_HIT {
                 node_index = stack[top];
                 popped = true;
                 break;

@@ -103,8 +103,9 @@ pub fn bvh_traverse(
         index: 0,
     };
     let mut found = false;
+    // Node indices only, as the kernel keeps them: a popped node's entry distance is
+    // recomputed by the same arithmetic, so the decision is the same.
     let mut stack = [0u32; BVH_STACK_SIZE];
-    let mut stack_t = [0f32; BVH_STACK_SIZE];
     let mut top = 0usize;
     let mut node_index = 0usize;
     if hit_box(&nodes[0], r, best.t) == NO_HIT {
@@ -139,7 +140,6 @@ pub fn bvh_traverse(
             if t_left != NO_HIT && t_right != NO_HIT {
                 let left_first = t_left <= t_right;
                 stack[top] = if left_first { left + 1 } else { left };
-                stack_t[top] = if left_first { t_right } else { t_left };
                 top += 1;
                 node_index = if left_first { left } else { left + 1 } as usize;
                 continue;
@@ -157,7 +157,7 @@ pub fn bvh_traverse(
         let mut popped = false;
         while top > 0 {
             top -= 1;
-            if stack_t[top] <= widened(best.t) {
+            if hit_box(&nodes[stack[top] as usize], r, best.t) != NO_HIT {
                 node_index = stack[top] as usize;
                 popped = true;
                 break;
