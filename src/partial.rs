@@ -58,17 +58,55 @@ pub struct Partial {
 
 /// A hash of everything that decides the image besides the sample range: the kernel's view
 /// of the scene (camera, size, bounces, seed, light sampling, roulette, every object and
-/// material), with the per-batch sample fields cleared. The kernel structs' `Debug` text is
-/// hashed so that any field added to them later is covered without a change here; `Debug`
-/// prints floats so that they read back exactly.
+/// material, textures, the environment map), with the per-batch sample fields cleared. The
+/// arrays' bytes are hashed (exact, and fast for maps of millions of texels). The
+/// destructuring names every field, so a field added later fails to compile until it is
+/// hashed or said not to matter. The BVH is left out: it is derived from the primitives, its
+/// build time differs from run to run, and it does not change what a path sees.
 pub fn settings_hash(scene: &KernelScene) -> String {
-    let mut scene = scene.clone();
-    scene.params.sample_start = 0;
-    scene.params.sample_count = 0;
-    scene.params.accumulated_samples = 0;
+    let KernelScene {
+        params,
+        spheres,
+        quads,
+        materials,
+        emitters,
+        triangles,
+        triangle_normals,
+        bvh_nodes: _,
+        bvh_primitives: _,
+        bvh_build_seconds: _,
+        textures,
+        texels,
+        triangle_uvs,
+        environment_texels,
+        environment_alias,
+    } = scene;
+    let mut params = *params;
+    params.sample_start = 0;
+    params.sample_count = 0;
+    params.accumulated_samples = 0;
     let mut hasher = Sha256::new();
     hasher.update(concat!("glint ", env!("CARGO_PKG_VERSION"), "\n"));
-    hasher.update(format!("{scene:?}"));
+    let mut array = |name: &str, bytes: &[u8]| {
+        // Name and length first, so bytes cannot shift from one array into the next.
+        hasher.update(format!("{name} {}\n", bytes.len()));
+        hasher.update(bytes);
+    };
+    array("params", bytemuck::bytes_of(&params));
+    array("spheres", bytemuck::cast_slice(spheres));
+    array("quads", bytemuck::cast_slice(quads));
+    array("materials", bytemuck::cast_slice(materials));
+    array("emitters", bytemuck::cast_slice(emitters));
+    array("triangles", bytemuck::cast_slice(triangles));
+    array("triangle normals", bytemuck::cast_slice(triangle_normals));
+    array("textures", bytemuck::cast_slice(textures));
+    array("texels", bytemuck::cast_slice(texels));
+    array("triangle uvs", bytemuck::cast_slice(triangle_uvs));
+    array(
+        "environment texels",
+        bytemuck::cast_slice(environment_texels),
+    );
+    array("environment alias", bytemuck::cast_slice(environment_alias));
     let mut hex = String::with_capacity(64);
     for byte in hasher.finalize() {
         write!(hex, "{byte:02x}").expect("writing to a String");

@@ -526,3 +526,28 @@ fn sample_ranges_and_shards_are_checked_before_rendering() {
     ok(&run(&["--samples", "1..3"], &[]));
     assert!(d.join("cornell.1-3.exr").exists());
 }
+
+/// The settings hash that partial renders must share: equal for the same scene loaded twice
+/// (a mesh scene too, whose BVH build time differs from run to run, and one with an
+/// environment map and textures), different when anything that changes the image changes.
+#[test]
+fn settings_hash_is_stable_across_loads_and_sees_changes() {
+    use glint::partial::settings_hash;
+    for name in ["bunny.toml", "sun.toml", "cornell-textured.toml"] {
+        let first = settings_hash(&common::shipped_scene(name).kernel_scene());
+        let again = settings_hash(&common::shipped_scene(name).kernel_scene());
+        assert_eq!(first, again, "{name}");
+        let mut changed = common::shipped_scene(name).kernel_scene();
+        changed.params.seed += 1;
+        assert_ne!(settings_hash(&changed), first, "{name}: seed");
+        let mut changed = common::shipped_scene(name).kernel_scene();
+        if let Some(t) = changed.environment_texels.first_mut() {
+            t.radiance[0] += 1.0;
+            assert_ne!(settings_hash(&changed), first, "{name}: a texel of the map");
+        }
+        if let Some(t) = changed.texels.first_mut() {
+            t[1] *= 0.5;
+            assert_ne!(settings_hash(&changed), first, "{name}: a texture texel");
+        }
+    }
+}
