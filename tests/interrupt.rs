@@ -229,7 +229,11 @@ fn a_failing_checkpoint_does_not_stop_the_render() {
             .spawn()
             .unwrap();
         wait_for("a checkpoint", Duration::from_secs(60), || out.exists());
-        std::fs::remove_dir_all(&sub).unwrap();
+        // glint writes a checkpoint's temporary file into the folder after every batch, so a
+        // removal can race with a new file (DirectoryNotEmpty): retry until it is gone.
+        wait_for("the folder removed", Duration::from_secs(30), || {
+            std::fs::remove_dir_all(&sub).is_ok() || !sub.exists()
+        });
         std::thread::sleep(Duration::from_millis(500));
         if recreate {
             std::fs::create_dir(&sub).unwrap();
