@@ -20,14 +20,17 @@ fn from_map_frame(d: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(c * d.x + s * d.z, d.y, c * d.z - s * d.x);
 }
 
-// Index of the texel a unit direction (in the scene) looks at.
+// Index of the texel a unit direction (in the scene) looks at. The angles come from the
+// polynomial atan2 the textures use (not atan2 and acos, which Vulkan lets be 4096 ulps off),
+// so the GPU picks the CPU's texel; theta = atan2(sqrt(x^2 + z^2), y) keeps its precision at
+// the poles, where acos(y) loses it.
 fn environment_texel_index(dir: vec3<f32>) -> u32 {
     let d = to_map_frame(dir);
-    var u = atan2(d.x, -d.z) * (0.5 / PI);
+    var u = polynomial_atan2(d.x, -d.z) * (0.5 / PI);
     if u < 0.0 {
         u += 1.0;
     }
-    let v = acos(clamp(d.y, -1.0, 1.0)) * (1.0 / PI);
+    let v = polynomial_atan2(sqrt(d.x * d.x + d.z * d.z), d.y) * (1.0 / PI);
     let w = params.environment_width;
     let h = params.environment_height;
     let x = min(u32(u * f32(w)), w - 1u);

@@ -4,6 +4,7 @@
 
 use super::material::PI;
 use super::rng::Rng;
+use super::texture::polynomial_atan2;
 use super::trace::SceneRefs;
 use crate::shader_types::Params;
 use glam::Vec3;
@@ -20,14 +21,17 @@ pub fn from_map_frame(params: &Params, d: Vec3) -> Vec3 {
     Vec3::new(c * d.x + s * d.z, d.y, c * d.z - s * d.x)
 }
 
-/// Index of the texel a unit direction (in the scene) looks at.
+/// Index of the texel a unit direction (in the scene) looks at. The angles come from the
+/// polynomial atan2 the textures use (not atan2 and acos, which Vulkan lets be 4096 ulps
+/// off), so the GPU picks the CPU's texel; θ = atan2(√(x² + z²), y) keeps its precision at
+/// the poles, where acos(y) loses it.
 pub fn environment_texel_index(params: &Params, dir: Vec3) -> u32 {
     let d = to_map_frame(params, dir);
-    let mut u = d.x.atan2(-d.z) * (0.5 / PI);
+    let mut u = polynomial_atan2(d.x, -d.z) * (0.5 / PI);
     if u < 0.0 {
         u += 1.0;
     }
-    let v = d.y.clamp(-1.0, 1.0).acos() * (1.0 / PI);
+    let v = polynomial_atan2((d.x * d.x + d.z * d.z).sqrt(), d.y) * (1.0 / PI);
     let (w, h) = (params.environment_width, params.environment_height);
     let x = ((u * w as f32) as u32).min(w - 1);
     let y = ((v * h as f32) as u32).min(h - 1);
