@@ -176,11 +176,15 @@ fn variance_ratio(a: &(Image, Image), b: &(Image, Image)) -> (f64, f64) {
     (ratio, spread.sqrt() / sv)
 }
 
-/// `--target-error` stops when the estimated relative error reaches the target, and the real
-/// error is then near the target. The scene is the floor under an emitting sphere from
+/// `--target-error` stops when the estimated relative error reaches the target, and the
+/// estimate is the real error. The scene is the floor under an emitting sphere from
 /// tests/closed_form.rs, whose every pixel is ρ L (r/d)² = 0.6 exactly, so the real error
 /// needs no reference: √(mean (pixel − 0.6)²) / 0.6. With 16×16 pixels that RMS is known to
-/// ±1/√(2·256) = ±4.4% (one σ) of itself; the ±25% band is about 6σ wide.
+/// ±1/√(2·256) = ±4.4% (one σ) of itself; the ±25% band between the real and the estimated
+/// error is about 6σ wide. Where the render stops depends on the batch sizes (timed, so they
+/// vary with the machine's load), and below 64 spp batches end at powers of two (the fixed
+/// merge schedule), so the spp can grow up to 4× between checks: the error at the stop lies
+/// between half the target and the target, less the estimate's noise (hence 0.4×).
 #[test]
 fn target_error_stops_with_the_real_error_near_the_target() {
     let Some(ctx) = gpu() else { return };
@@ -216,7 +220,14 @@ fn target_error_stops_with_the_real_error_near_the_target() {
         stats.spp
     );
     assert!(estimated <= target);
-    assert!((real / target - 1.0).abs() < 0.25, "real error {real}");
+    assert!(
+        estimated >= 0.4 * target,
+        "stopped far too late: {estimated}"
+    );
+    assert!(
+        (real / estimated - 1.0).abs() < 0.25,
+        "real error {real}, estimated {estimated}"
+    );
 }
 
 /// Light sampling changes the variance, not the expectation: the Cornell box rendered with and
