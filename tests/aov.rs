@@ -5,10 +5,9 @@
 mod common;
 use common::{gpu, kernel_scene, PathAgreement};
 use glint::aov::{Aovs, BACKGROUND_DEPTH};
-use glint::cpu::renderer::CpuRenderer;
 use glint::gpu::GpuRenderer;
 use glint::output::Image;
-use glint::render::{render_image, Renderer};
+use glint::render::render_image;
 use glint::scene::KernelScene;
 
 /// Renders `spp` samples in batches of `batch` with AOVs on, on the CPU and (where there is
@@ -16,12 +15,7 @@ use glint::scene::KernelScene;
 fn render_aovs(scene: &KernelScene, spp: u32, batch: u32) -> Vec<(&'static str, Image, Aovs)> {
     let mut scene = scene.clone();
     scene.params.aovs = 1;
-    let mut renderers: Vec<(&'static str, Box<dyn Renderer>)> =
-        vec![("cpu", Box::new(CpuRenderer::new(&scene)))];
-    if let Some(ctx) = gpu() {
-        renderers.push(("gpu", Box::new(GpuRenderer::new(ctx, &scene).unwrap())));
-    }
-    renderers
+    common::renderers(&scene)
         .into_iter()
         .map(|(name, mut r)| {
             let mean = render_image(r.as_mut(), spp, batch).unwrap();

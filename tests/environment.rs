@@ -6,7 +6,6 @@ mod common;
 use common::{largest_deviation, render_both, PathAgreement};
 use glint::compare::compare;
 use glint::cpu::renderer::CpuRenderer;
-use glint::gpu::GpuRenderer;
 use glint::output::Image;
 use glint::render::{render_image, Renderer};
 use glint::scene::{KernelScene, RenderOverrides, Scene};
@@ -62,14 +61,13 @@ fn render_with_variance(renderer: &mut dyn Renderer, spp: u32) -> (Image, Image)
 
 /// Renders on the CPU and, where there is one, the GPU, with variance images.
 fn render_both_with_variance(scene: &KernelScene, spp: u32) -> Vec<(&'static str, Image, Image)> {
-    let (image, variance) = render_with_variance(&mut CpuRenderer::new(scene), spp);
-    let mut out = vec![("cpu", image, variance)];
-    if let Some(ctx) = common::gpu() {
-        let (image, variance) =
-            render_with_variance(&mut GpuRenderer::new(ctx, scene).unwrap(), spp);
-        out.push(("gpu", image, variance));
-    }
-    out
+    common::renderers(scene)
+        .into_iter()
+        .map(|(device, mut renderer)| {
+            let (image, variance) = render_with_variance(renderer.as_mut(), spp);
+            (device, image, variance)
+        })
+        .collect()
 }
 
 const OBJECTS: &str = r#"
@@ -555,12 +553,7 @@ fn the_albedo_aov_of_escaping_rays_is_the_maps_clamped_radiance() {
     );
     let mut kernel = scene.kernel_scene();
     kernel.params.aovs = 1;
-    let mut renderers: Vec<(&str, Box<dyn Renderer>)> =
-        vec![("cpu", Box::new(CpuRenderer::new(&kernel)))];
-    if let Some(ctx) = common::gpu() {
-        renderers.push(("gpu", Box::new(GpuRenderer::new(ctx, &kernel).unwrap())));
-    }
-    for (device, mut renderer) in renderers {
+    for (device, mut renderer) in common::renderers(&kernel) {
         renderer.add_samples(2).unwrap();
         let aovs = renderer.read_aovs().unwrap();
         assert!(

@@ -97,12 +97,7 @@ fn assert_finite(image: &Image, what: &str) {
 /// CPU (and, where there is one, GPU) render: finite mean and variance, no dropped sample.
 fn assert_renders_finite(scene: &KernelScene, spp: u32) -> Vec<Image> {
     let mut images = Vec::new();
-    let mut renderers: Vec<(&str, Box<dyn Renderer>)> =
-        vec![("cpu", Box::new(CpuRenderer::new(scene)))];
-    if let Some(ctx) = gpu() {
-        renderers.push(("gpu", Box::new(GpuRenderer::new(ctx, scene).unwrap())));
-    }
-    for (name, mut r) in renderers {
+    for (name, mut r) in common::renderers(scene) {
         let mean = render_image(r.as_mut(), spp, spp).unwrap();
         assert_finite(&mean, &format!("{name} mean"));
         assert_finite(&r.read_variance().unwrap(), &format!("{name} variance"));
@@ -267,12 +262,7 @@ fn non_finite_samples_are_dropped_and_counted() {
         }
     }
     let pixels = (scene.params.width * scene.params.height) as u64;
-    let mut renderers: Vec<(&str, Box<dyn Renderer>)> =
-        vec![("cpu", Box::new(CpuRenderer::new(&scene)))];
-    if let Some(ctx) = gpu() {
-        renderers.push(("gpu", Box::new(GpuRenderer::new(ctx, &scene).unwrap())));
-    }
-    for (name, mut r) in renderers {
+    for (name, mut r) in common::renderers(&scene) {
         let mean = render_image(r.as_mut(), 4, 4).unwrap();
         assert_finite(&mean, name);
         assert_finite(&r.read_variance().unwrap(), name);

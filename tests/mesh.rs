@@ -530,17 +530,7 @@ smooth = false
         let path = dir.path().join("furnace.toml");
         std::fs::write(&path, text).unwrap();
         let scene = Scene::load(&path).unwrap().kernel_scene();
-        let mut renderers: Vec<(&str, Box<dyn glint::render::Renderer>)> = vec![(
-            "cpu",
-            Box::new(glint::cpu::renderer::CpuRenderer::new(&scene)),
-        )];
-        if let Some(ctx) = gpu() {
-            renderers.push((
-                "gpu",
-                Box::new(glint::gpu::GpuRenderer::new(ctx, &scene).unwrap()),
-            ));
-        }
-        for (device, mut renderer) in renderers {
+        for (device, mut renderer) in common::renderers(&scene) {
             let (image, variance) = mean_and_variance(renderer.as_mut());
             if light_sampling {
                 let sigma = (variance.mean() / image.pixels.len() as f64).sqrt();

@@ -8,7 +8,7 @@ pub mod probe;
 use glint::cpu::renderer::CpuRenderer;
 use glint::gpu::{GpuContext, GpuRenderer};
 use glint::output::Image;
-use glint::render::render_image;
+use glint::render::{render_image, Renderer};
 use glint::scene::{KernelScene, Scene};
 use std::path::Path;
 use std::sync::OnceLock;
@@ -48,6 +48,16 @@ pub fn render_cpu(scene: &KernelScene, spp: u32) -> Image {
 
 pub fn render_gpu(ctx: &GpuContext, scene: &KernelScene, spp: u32) -> Image {
     render_image(&mut GpuRenderer::new(ctx, scene).unwrap(), spp, spp).unwrap()
+}
+
+/// A CPU renderer for `scene` and, where there is a GPU, a GPU one: (device name, renderer).
+pub fn renderers(scene: &KernelScene) -> Vec<(&'static str, Box<dyn Renderer>)> {
+    let mut out: Vec<(&'static str, Box<dyn Renderer>)> =
+        vec![("cpu", Box::new(CpuRenderer::new(scene)))];
+    if let Some(ctx) = gpu() {
+        out.push(("gpu", Box::new(GpuRenderer::new(ctx, scene).unwrap())));
+    }
+    out
 }
 
 /// Renders on the CPU and, where there is a GPU, on the GPU too: (device name, image) pairs.
