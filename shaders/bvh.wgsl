@@ -45,6 +45,16 @@ fn hit_box(node: BvhNode, r: BvhRay, t_max: f32) -> f32 {
     return NO_HIT;
 }
 
+// Node i, from the uniform copy of the top of the tree when it is there: lavapipe loads from a
+// uniform buffer with one gather, from a storage buffer with a loop over the lanes (see
+// bvh_uniform_nodes in src/shader.rs). The values are the same, so the paths are too.
+fn bvh_node(i: u32) -> BvhNode {
+    if i < BVH_UNIFORM_NODES {
+        return bvh_top_nodes[i];
+    }
+    return bvh_nodes[i];
+}
+
 fn hit_primitive(reference: u32, r: BvhRay) -> f32 {
     let kind = reference >> PRIMITIVE_KIND_SHIFT;
     let index = reference & PRIMITIVE_INDEX_MASK;
@@ -70,11 +80,11 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
     var stack: array<u32, BVH_STACK_SIZE>;
     var top = 0u;
     var node_index = 0u;
-    if hit_box(bvh_nodes[0], r, best.t) == NO_HIT {
+    if hit_box(bvh_node(0u), r, best.t) == NO_HIT {
         return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
     }
     loop {
-        let node = bvh_nodes[node_index];
+        let node = bvh_node(node_index);
         if node.count > 0u {
             for (var i = 0u; i < node.count; i++) {
                 let reference = bvh_primitives[node.first + i];
@@ -89,8 +99,8 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
             }
         } else {
             let left = node.first;
-            let t_left = hit_box(bvh_nodes[left], r, best.t);
-            let t_right = hit_box(bvh_nodes[left + 1u], r, best.t);
+            let t_left = hit_box(bvh_node(left), r, best.t);
+            let t_right = hit_box(bvh_node(left + 1u), r, best.t);
             if t_left != NO_HIT && t_right != NO_HIT {
                 let left_first = t_left <= t_right;
                 stack[top] = select(left, left + 1u, left_first);
@@ -111,7 +121,7 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
         var popped = false;
         while top > 0u {
             top -= 1u;
-            if hit_box(bvh_nodes[stack[top]], r, best.t) != NO_HIT {
+            if hit_box(bvh_node(stack[top]), r, best.t) != NO_HIT {
                 node_index = stack[top];
                 popped = true;
                 break;

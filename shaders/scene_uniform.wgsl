@@ -14,6 +14,8 @@
 @group(0) @binding(8) var<storage, read> triangles: array<Triangle>;
 @group(0) @binding(9) var<storage, read> triangle_normals: array<TriangleNormals>;
 @group(0) @binding(12) var<storage, read> bvh_nodes: array<BvhNode>;
+// The first BVH_UNIFORM_NODES of bvh_nodes again, in a uniform buffer (shaders/bvh.wgsl).
+@group(0) @binding(23) var<uniform> bvh_top_nodes: array<BvhNode, BVH_UNIFORM_NODES>;
 @group(0) @binding(13) var<storage, read> bvh_primitives: array<u32>;
 
 fn sphere_count() -> u32 {

@@ -2,7 +2,7 @@
 
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    Emitter, Material, Quad, Sphere, MATERIAL_DIELECTRIC, MATERIAL_METAL, PRIMITIVE_QUAD,
+    BvhNode, Emitter, Material, Quad, Sphere, MATERIAL_DIELECTRIC, MATERIAL_METAL, PRIMITIVE_QUAD,
     PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 
@@ -50,8 +50,22 @@ pub enum SceneBinding {
     /// (`shaders/scene_uniform.wgsl`): 1.2–2.3× faster on lavapipe, for scenes that fit.
     Uniform(SceneCounts),
     /// Storage buffers traversed through the scene's BVH (`shaders/bvh.wgsl`): scenes with
-    /// meshes or many objects, which [`KernelScene::bvh_nodes`] then holds.
-    Bvh,
+    /// meshes or many objects, which [`KernelScene::bvh_nodes`] then holds. The first
+    /// `uniform_nodes` nodes (the top levels: the tree is laid out breadth first) are also in
+    /// a uniform buffer, which lavapipe reads far faster ([`bvh_uniform_nodes`]).
+    Bvh { uniform_nodes: u32 },
+}
+
+/// How many of the BVH's top nodes the kernel reads from a uniform buffer on a device whose
+/// uniform bindings hold `max_uniform_binding` bytes: as many as fit in it and in
+/// [`MAX_UNIFORM_SCENE_BYTES`] (2048 on lavapipe and NVIDIA: the top 11 levels).
+/// Why: llvmpipe turns a storage-buffer load whose address differs between lanes into a loop
+/// over the lanes with a branch per lane, a uniform-buffer load into one gather, and a
+/// traversal reads mostly nodes (BENCHMARKS.md, "Why lavapipe's BVH kernel is slow": +45% at
+/// 10³ triangles, whose whole tree fits).
+pub fn bvh_uniform_nodes(max_uniform_binding: u64) -> u32 {
+    let bytes = max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES);
+    (bytes / size_of::<BvhNode>() as u64).max(1) as u32
 }
 
 /// How many of each object a scene has.
@@ -98,7 +112,9 @@ impl SceneBinding {
     /// device's limit) and in [`MAX_UNIFORM_SCENE_BYTES`], storage buffers otherwise.
     pub fn for_scene(scene: &KernelScene, max_uniform_binding: u64) -> SceneBinding {
         if !scene.bvh_nodes.is_empty() {
-            return SceneBinding::Bvh;
+            return SceneBinding::Bvh {
+                uniform_nodes: bvh_uniform_nodes(max_uniform_binding),
+            };
         }
         let counts = SceneCounts::of(scene);
         if counts.largest_uniform_buffer() <= max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES) {
@@ -113,27 +129,31 @@ impl SceneBinding {
         match self {
             SceneBinding::Storage => "storage",
             SceneBinding::Uniform(_) => "uniform",
-            SceneBinding::Bvh => "bvh",
+            SceneBinding::Bvh { .. } => "bvh",
         }
     }
 
     /// The WGSL declaring the scene's bindings, as a named part.
     fn part(&self) -> (&'static str, String) {
         // Triangles exist only in the storage layouts; the uniform one compiles their code out.
-        let storage = |bvh: bool| {
+        let storage = |bvh: bool, uniform_nodes: u32| {
             format!(
-                "const USE_BVH: bool = {bvh};\nconst HAS_TRIANGLES: bool = true;\n{SCENE_STORAGE}"
+                "const USE_BVH: bool = {bvh};\nconst HAS_TRIANGLES: bool = true;\n\
+                 const BVH_UNIFORM_NODES: u32 = {uniform_nodes}u;\n{SCENE_STORAGE}"
             )
         };
         match self {
-            SceneBinding::Storage => ("scene_storage.wgsl", storage(false)),
-            SceneBinding::Bvh => ("scene_storage.wgsl", storage(true)),
+            SceneBinding::Storage => ("scene_storage.wgsl", storage(false, 1)),
+            SceneBinding::Bvh { uniform_nodes } => {
+                ("scene_storage.wgsl", storage(true, *uniform_nodes))
+            }
             SceneBinding::Uniform(c) => (
                 "scene_uniform.wgsl",
                 format!(
                     "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
                      const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
-                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n{}",
+                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n\
+                     const BVH_UNIFORM_NODES: u32 = 1u;\n{}",
                     c.spheres, c.quads, c.materials, c.emitters, SCENE_UNIFORM
                 ),
             ),

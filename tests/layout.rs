@@ -310,7 +310,9 @@ fn every_feature_combination_validates() {
         for binding in [
             SceneBinding::Storage,
             SceneBinding::Uniform(counts),
-            SceneBinding::Bvh,
+            SceneBinding::Bvh {
+                uniform_nodes: 2048,
+            },
         ] {
             validate_source(render_kernel_source_for(KernelVariant {
                 binding,

@@ -10,7 +10,8 @@ use glint::output::Image;
 use glint::render::render_image;
 use glint::scene::KernelScene;
 use glint::shader::{
-    KernelFeatures, KernelVariant, SceneBinding, SceneCounts, MAX_UNIFORM_SCENE_BYTES,
+    bvh_uniform_nodes, KernelFeatures, KernelVariant, SceneBinding, SceneCounts,
+    MAX_UNIFORM_SCENE_BYTES,
 };
 
 fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
@@ -109,7 +110,7 @@ fn large_scene_renders_through_storage_buffers_like_the_cpu() {
     for seed in [1, 2] {
         let scene = tiled_cornell(700, 64, seed);
         let mut renderer = GpuRenderer::new(ctx, &scene).unwrap();
-        assert_eq!(renderer.scene_binding(), SceneBinding::Bvh);
+        assert!(matches!(renderer.scene_binding(), SceneBinding::Bvh { .. }));
         let gpu_image = render_image(&mut renderer, 1, 1).unwrap();
         agreement.add(&render_cpu(&scene, 1), &gpu_image);
         let scene = without_bvh(scene);
@@ -119,6 +120,48 @@ fn large_scene_renders_through_storage_buffers_like_the_cpu() {
         agreement.add(&render_cpu(&scene, 1), &gpu_image);
     }
     agreement.check(0.99);
+}
+
+/// The BVH's top nodes: as many as 64 KiB (or the device's smaller limit) holds, whatever the
+/// scene, so the kernel for a device does not change with the tree.
+#[test]
+fn bvh_top_nodes_fill_the_uniform_limit() {
+    assert_eq!(bvh_uniform_nodes(65536), 2048);
+    assert_eq!(bvh_uniform_nodes(1 << 30), 2048);
+    assert_eq!(bvh_uniform_nodes(16384), 512);
+    let bunny = sized(shipped_scene("bunny.toml"), 8, 0);
+    assert_eq!(
+        SceneBinding::for_scene(&bunny, 65536),
+        SceneBinding::Bvh {
+            uniform_nodes: 2048
+        }
+    );
+}
+
+/// Reading the BVH's top nodes from the uniform copy, for all of a small tree or the top of a
+/// large one, gives the same image bit for bit as reading every node from the storage buffer
+/// (one node in the copy). The bunny's tree has 1633 nodes: 2048 holds all of it, and 64 or
+/// 512 put the boundary mid-tree, so traversals cross from one buffer to the other.
+#[test]
+fn bvh_top_nodes_in_a_uniform_buffer_do_not_change_the_image() {
+    if gpu().is_none() {
+        return;
+    }
+    let bunny = sized(shipped_scene("bunny.toml"), 32, 3);
+    assert!(bunny.bvh_nodes.len() > 512, "{}", bunny.bvh_nodes.len());
+    let small = sized(shipped_scene("cornell-mesh.toml"), 32, 4);
+    for (name, scene) in [("bunny", bunny), ("cornell-mesh", small)] {
+        let storage_only = render_with(&scene, SceneBinding::Bvh { uniform_nodes: 1 }, 2);
+        assert!(
+            storage_only.pixels.iter().any(|p| p[0] > 0.0),
+            "{name} is black"
+        );
+        for uniform_nodes in [64, 512, 2048] {
+            let image = render_with(&scene, SceneBinding::Bvh { uniform_nodes }, 2);
+            let differing = differing_pixels(&storage_only, &image);
+            assert_eq!(differing, 0, "{name} with {uniform_nodes} uniform nodes");
+        }
+    }
 }
 
 /// Kernels with unused features compiled out render exactly what the kernel with everything

@@ -16,7 +16,7 @@ use crate::shader::{
     render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding, RENDER_ENTRY_POINT,
     WORKGROUP_SIZE,
 };
-use crate::shader_types::Params;
+use crate::shader_types::{BvhNode, Params};
 use anyhow::{anyhow, Result};
 use bytemuck::Pod;
 use wgpu::util::DeviceExt;
@@ -153,8 +153,12 @@ impl<'a> GpuRenderer<'a> {
         } else {
             16
         };
+        let uniform_nodes = match variant.binding {
+            SceneBinding::Bvh { uniform_nodes } => uniform_nodes.max(1),
+            _ => 1,
+        };
         let (usage, scene_type) = match variant.binding {
-            SceneBinding::Storage | SceneBinding::Bvh => (
+            SceneBinding::Storage | SceneBinding::Bvh { .. } => (
                 wgpu::BufferUsages::STORAGE,
                 wgpu::BufferBindingType::Storage { read_only: true },
             ),
@@ -179,6 +183,11 @@ impl<'a> GpuRenderer<'a> {
                     read_only,
                 ),
                 BufferNeed::new("BVH nodes", array_bytes(&scene.bvh_nodes), read_only),
+                BufferNeed::new(
+                    "BVH top nodes",
+                    uniform_nodes as u64 * size_of::<BvhNode>() as u64,
+                    wgpu::BufferBindingType::Uniform,
+                ),
                 BufferNeed::new(
                     "BVH primitives",
                     array_bytes(&scene.bvh_primitives),
@@ -220,6 +229,15 @@ impl<'a> GpuRenderer<'a> {
         let triangles = storage_buffer(ctx, "triangles", &scene.triangles);
         let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
         let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
+        let mut top_nodes =
+            scene.bvh_nodes[..scene.bvh_nodes.len().min(uniform_nodes as usize)].to_vec();
+        top_nodes.resize(uniform_nodes as usize, BvhNode::default());
+        let bvh_top_nodes = scene_buffer(
+            ctx,
+            "BVH top nodes",
+            &top_nodes,
+            wgpu::BufferUsages::UNIFORM,
+        );
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
         // Textures are storage buffers in every layout (shaders/texture.wgsl says why).
         let textures = storage_buffer(ctx, "textures", &scene.textures);
@@ -279,6 +297,7 @@ impl<'a> GpuRenderer<'a> {
                 (8, read_only, &triangles),
                 (9, read_only, &triangle_normals),
                 (12, read_only, &bvh_nodes),
+                (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
                 (13, read_only, &bvh_primitives),
                 (10, read_write, &aov_buffers[0]),
                 (11, read_write, &aov_buffers[1]),
