@@ -52,6 +52,10 @@ pub fn run_probe(
     };
     let scene_params = uniform(bytemuck::bytes_of(&scene.params));
     let probe_params = uniform(bytemuck::bytes_of(&params));
+    // The general kernel keeps one node (the root) in its uniform copy of the BVH's top.
+    let bvh_top_nodes = uniform(bytemuck::bytes_of(
+        &scene.bvh_nodes.first().copied().unwrap_or_default(),
+    ));
     let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
     let quads = storage_buffer(ctx, "quads", &scene.quads);
     let materials = storage_buffer(ctx, "materials", &scene.materials);
@@ -93,6 +97,7 @@ pub fn run_probe(
             (8, read_only, &triangles),
             (9, read_only, &triangle_normals),
             (12, read_only, &bvh_nodes),
+            (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
             (13, read_only, &bvh_primitives),
             (10, wgpu::BufferBindingType::Uniform, &probe_params),
             (11, read_write, &out),
