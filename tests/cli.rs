@@ -563,3 +563,29 @@ fn bad_command_lines_are_one_line_with_exit_2() {
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stdout).contains("Usage"));
 }
+
+/// A shader cache folder whose parents do not exist yet is created before the GPU opens.
+/// Mesa creates only the last folder and otherwise disables its cache, and lavapipe then
+/// recompiled the kernel for every dispatch: minutes per sample on a mesh scene. Where there
+/// is no GPU the render falls back to the CPU, but the folder is still made.
+#[test]
+fn missing_shader_cache_folders_are_created() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("a").join("b");
+    let scene = scene_path("cornell.toml");
+    let out = Command::new(GLINT)
+        .args(["render", scene.to_str().unwrap()])
+        .args([
+            "--width", "8", "--height", "8", "--spp", "1", "-o", "out.exr",
+        ])
+        .env("MESA_SHADER_CACHE_DIR", &cache)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(cache.is_dir(), "{} was not created", cache.display());
+}

@@ -18,6 +18,38 @@ pub struct GpuContext {
     errors: Arc<Mutex<Vec<String>>>,
 }
 
+/// Creates the folder Mesa keeps its shader cache in, before the Vulkan devices are enumerated
+/// (when lavapipe opens its cache), and warns when that fails. Mesa creates only the last
+/// folder of the path and otherwise disables the cache, and lavapipe then recompiles the
+/// kernel for every dispatch: a mesh scene, one sample per dispatch, spent minutes per sample
+/// in LLVM. The folder is Mesa's: `MESA_SHADER_CACHE_DIR`, else `$XDG_CACHE_HOME`, else
+/// `$HOME/.cache`. Other drivers ignore it.
+fn prepare_mesa_shader_cache() {
+    use std::env::var_os;
+    use std::path::PathBuf;
+    if var_os("MESA_SHADER_CACHE_DISABLE").is_some() || var_os("MESA_DISK_CACHE_DISABLE").is_some()
+    {
+        return;
+    }
+    let folder = match (
+        var_os("MESA_SHADER_CACHE_DIR"),
+        var_os("XDG_CACHE_HOME"),
+        var_os("HOME"),
+    ) {
+        (Some(dir), _, _) => PathBuf::from(dir),
+        (None, Some(cache), _) => PathBuf::from(cache),
+        (None, None, Some(home)) => PathBuf::from(home).join(".cache"),
+        (None, None, None) => return,
+    };
+    if let Err(e) = std::fs::create_dir_all(&folder) {
+        crate::errln!(
+            "glint: warning: cannot create the shader cache folder {} ({e}); lavapipe will \
+             recompile the kernel for every dispatch (set MESA_SHADER_CACHE_DIR to a writable folder)",
+            folder.display()
+        );
+    }
+}
+
 impl GpuContext {
     /// Opens the first Vulkan adapter (high performance preferred). Only Vulkan is enabled:
     /// with every backend on, a machine without a Vulkan driver silently gets an OpenGL
@@ -34,6 +66,7 @@ impl GpuContext {
         instance: &wgpu::Instance,
         surface: Option<&wgpu::Surface<'_>>,
     ) -> Result<GpuContext, GpuUnavailable> {
+        prepare_mesa_shader_cache();
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: surface,
