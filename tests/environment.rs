@@ -7,7 +7,7 @@ use common::{largest_deviation, render_both, PathAgreement};
 use glint::compare::compare;
 use glint::cpu::renderer::CpuRenderer;
 use glint::output::Image;
-use glint::render::{render_image, Renderer};
+use glint::render::render_image;
 use glint::scene::{KernelScene, RenderOverrides, Scene};
 use std::path::{Path, PathBuf};
 
@@ -54,17 +54,12 @@ fn with_light_sampling(scene: &Scene, on: bool, seed: u32) -> KernelScene {
 }
 
 /// The mean image and the variance image of its pixel means.
-fn render_with_variance(renderer: &mut dyn Renderer, spp: u32) -> (Image, Image) {
-    let image = render_image(renderer, spp, spp).unwrap();
-    (image, renderer.read_variance().unwrap())
-}
-
 /// Renders on the CPU and, where there is one, the GPU, with variance images.
 fn render_both_with_variance(scene: &KernelScene, spp: u32) -> Vec<(&'static str, Image, Image)> {
     common::renderers(scene)
         .into_iter()
         .map(|(device, mut renderer)| {
-            let (image, variance) = render_with_variance(renderer.as_mut(), spp);
+            let (image, variance) = common::render_with_variance(renderer.as_mut(), spp);
             (device, image, variance)
         })
         .collect()

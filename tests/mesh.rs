@@ -340,19 +340,6 @@ fn gpu_closed_mesh_has_no_leaks_at_edges_and_vertices() {
     );
 }
 
-/// Renders `scene` to 256 spp: its mean and the variance image of its pixel means.
-fn mean_and_variance(
-    renderer: &mut dyn glint::render::Renderer,
-) -> (glint::output::Image, glint::output::Image) {
-    while renderer.samples() < 256 {
-        renderer.add_samples(64).unwrap();
-    }
-    (
-        renderer.read_mean().unwrap(),
-        renderer.read_variance().unwrap(),
-    )
-}
-
 /// A finely tessellated sphere (smooth-shaded, 256 segments × 128 rings, 65,024 triangles)
 /// renders the analytic sphere's image, up to the tessellation error derived here, on the
 /// sphere's pixels away from its silhouette.
@@ -439,12 +426,17 @@ material = "floor"
         2,
     );
     let a = match gpu() {
-        Some(ctx) => {
-            mean_and_variance(&mut glint::gpu::GpuRenderer::new(ctx, &tessellated).unwrap())
-        }
-        None => mean_and_variance(&mut glint::cpu::renderer::CpuRenderer::new(&tessellated)),
+        Some(ctx) => common::render_with_variance(
+            &mut glint::gpu::GpuRenderer::new(ctx, &tessellated).unwrap(),
+            256,
+        ),
+        None => common::render_with_variance(
+            &mut glint::cpu::renderer::CpuRenderer::new(&tessellated),
+            256,
+        ),
     };
-    let b = mean_and_variance(&mut glint::cpu::renderer::CpuRenderer::new(&analytic));
+    let b =
+        common::render_with_variance(&mut glint::cpu::renderer::CpuRenderer::new(&analytic), 256);
     // Pixels whose centre ray passes within 1 − s − (half a pixel diagonal at the sphere) of
     // the centre.
     let pixel_angle = (vfov.to_radians() / 2.0).tan() * 2.0 / size as f64;
@@ -531,7 +523,7 @@ smooth = false
         std::fs::write(&path, text).unwrap();
         let scene = Scene::load(&path).unwrap().kernel_scene();
         for (device, mut renderer) in common::renderers(&scene) {
-            let (image, variance) = mean_and_variance(renderer.as_mut());
+            let (image, variance) = common::render_with_variance(renderer.as_mut(), 256);
             if light_sampling {
                 let sigma = (variance.mean() / image.pixels.len() as f64).sqrt();
                 let z = (image.mean() - expected) / sigma;

@@ -50,6 +50,12 @@ pub fn render_gpu(ctx: &GpuContext, scene: &KernelScene, spp: u32) -> Image {
     render_image(&mut GpuRenderer::new(ctx, scene).unwrap(), spp, spp).unwrap()
 }
 
+/// `spp` samples per pixel in one batch: the image and the variance of each pixel's mean.
+pub fn render_with_variance(renderer: &mut dyn Renderer, spp: u32) -> (Image, Image) {
+    let image = render_image(renderer, spp, spp).unwrap();
+    (image, renderer.read_variance().unwrap())
+}
+
 /// A CPU renderer for `scene` and, where there is a GPU, a GPU one: (device name, renderer).
 pub fn renderers(scene: &KernelScene) -> Vec<(&'static str, Box<dyn Renderer>)> {
     let mut out: Vec<(&'static str, Box<dyn Renderer>)> =
