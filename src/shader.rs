@@ -124,6 +124,15 @@ impl SceneBinding {
         }
     }
 
+    /// How many nodes the kernel's uniform copy of the BVH's top holds (`BVH_UNIFORM_NODES`):
+    /// one, unused, in the layouts without a BVH.
+    pub fn uniform_node_count(&self) -> u32 {
+        match self {
+            SceneBinding::Bvh { uniform_nodes } => *uniform_nodes,
+            SceneBinding::Storage | SceneBinding::Uniform(_) => 1,
+        }
+    }
+
     /// Short name for benchmarks and logs.
     pub fn name(&self) -> &'static str {
         match self {
@@ -136,25 +145,24 @@ impl SceneBinding {
     /// The WGSL declaring the scene's bindings, as a named part.
     fn part(&self) -> (&'static str, String) {
         // Triangles exist only in the storage layouts; the uniform one compiles their code out.
-        let storage = |bvh: bool, uniform_nodes: u32| {
+        let uniform_nodes = self.uniform_node_count();
+        let storage = |bvh: bool| {
             format!(
                 "const USE_BVH: bool = {bvh};\nconst HAS_TRIANGLES: bool = true;\n\
                  const BVH_UNIFORM_NODES: u32 = {uniform_nodes}u;\n{SCENE_STORAGE}"
             )
         };
         match self {
-            SceneBinding::Storage => ("scene_storage.wgsl", storage(false, 1)),
-            SceneBinding::Bvh { uniform_nodes } => {
-                ("scene_storage.wgsl", storage(true, *uniform_nodes))
-            }
+            SceneBinding::Storage => ("scene_storage.wgsl", storage(false)),
+            SceneBinding::Bvh { .. } => ("scene_storage.wgsl", storage(true)),
             SceneBinding::Uniform(c) => (
                 "scene_uniform.wgsl",
                 format!(
                     "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
                      const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
                      const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n\
-                     const BVH_UNIFORM_NODES: u32 = 1u;\n{}",
-                    c.spheres, c.quads, c.materials, c.emitters, SCENE_UNIFORM
+                     const BVH_UNIFORM_NODES: u32 = {}u;\n{}",
+                    c.spheres, c.quads, c.materials, c.emitters, uniform_nodes, SCENE_UNIFORM
                 ),
             ),
         }

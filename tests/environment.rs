@@ -53,7 +53,6 @@ fn with_light_sampling(scene: &Scene, on: bool, seed: u32) -> KernelScene {
         .kernel_scene()
 }
 
-/// The mean image and the variance image of its pixel means.
 /// Renders on the CPU and, where there is one, the GPU, with variance images.
 fn render_both_with_variance(scene: &KernelScene, spp: u32) -> Vec<(&'static str, Image, Image)> {
     common::renderers(scene)

@@ -153,10 +153,7 @@ impl<'a> GpuRenderer<'a> {
         } else {
             16
         };
-        let uniform_nodes = match variant.binding {
-            SceneBinding::Bvh { uniform_nodes } => uniform_nodes.max(1),
-            _ => 1,
-        };
+        let uniform_nodes = variant.binding.uniform_node_count();
         let (usage, scene_type) = match variant.binding {
             SceneBinding::Storage | SceneBinding::Bvh { .. } => (
                 wgpu::BufferUsages::STORAGE,
