@@ -11,7 +11,7 @@ use crate::shader_types::{
     BvhNode, PRIMITIVE_ENVIRONMENT, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
     PRIMITIVE_TRIANGLE,
 };
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// Enough for any tree the host accepts: it rejects trees deeper than this.
 pub const BVH_STACK_SIZE: usize = 64;
@@ -25,7 +25,9 @@ pub struct BvhRay {
     pub ray: Ray,
     /// 1 / dir, with zero components replaced by a tiny value of the same sign, so the slab
     /// test never multiplies 0 by infinity.
-    pub inv_dir: Vec3,
+    pub inv_dir: Vec3A,
+    /// The origin again, in the SIMD layout the box test works in.
+    pub origin: Vec3A,
     pub tri: TriangleRay,
 }
 
@@ -38,7 +40,8 @@ pub fn bvh_ray(ray: &Ray) -> BvhRay {
     let dir = Vec3::select(ray.dir.abs().cmplt(Vec3::splat(1e-20)), tiny, ray.dir);
     BvhRay {
         ray: *ray,
-        inv_dir: 1.0 / dir,
+        inv_dir: Vec3A::from(1.0 / dir),
+        origin: Vec3A::from(ray.origin),
         tri: triangle_ray(ray),
     }
 }
@@ -62,13 +65,12 @@ pub fn widened(t: f32) -> f32 {
 /// of the best hit so far (as at a vertex many triangles share): the primitive tests decide
 /// those.
 pub fn hit_box(node: &BvhNode, r: &BvhRay, t_max: f32) -> f32 {
-    let t0 = (Vec3::from(node.min) - r.ray.origin) * r.inv_dir;
-    let t1 = (Vec3::from(node.max) - r.ray.origin) * r.inv_dir;
-    let near =
-        t0.x.min(t1.x)
-            .max(t0.y.min(t1.y))
-            .max(t0.z.min(t1.z).max(0.0));
-    let far = t0.x.max(t1.x).min(t0.y.max(t1.y)).min(t0.z.max(t1.z)) * BOX_SLACK;
+    // All three axes at once: the same IEEE operations as the kernel's per-component ones, and
+    // no NaN can arise (inv_dir is finite and non-zero), so min and max agree exactly.
+    let t0 = (Vec3A::from(node.min) - r.origin) * r.inv_dir;
+    let t1 = (Vec3A::from(node.max) - r.origin) * r.inv_dir;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = t0.max(t1).min_element() * BOX_SLACK;
     if near <= far.min(widened(t_max)) {
         return near;
     }
@@ -103,23 +105,28 @@ pub fn bvh_traverse(
         index: 0,
     };
     let mut found = false;
-    // Node indices only, as the kernel keeps them: a popped node's entry distance is
-    // recomputed by the same arithmetic, so the decision is the same.
-    let mut stack = [0u32; BVH_STACK_SIZE];
-    let mut top = 0usize;
-    let mut node_index = 0usize;
-    if hit_box(&nodes[0], r, best.t) == NO_HIT {
+    let root = &nodes[0];
+    if hit_box(root, r, best.t) == NO_HIT {
         return ClosestPrimitive {
             t: NO_HIT,
             primitive: PRIMITIVE_QUAD,
             index: 0,
         };
     }
+    // The node being entered, as its first and count, read with its box when its parent was
+    // visited. The kernel reads the node again instead, and keeps only node indices on its
+    // stack, redoing a popped node's box test: on lavapipe, per-lane memory costs more than
+    // that arithmetic, and carrying first and count measured no faster (BENCHMARKS.md). The
+    // decisions are the same: a popped node's entry distance has not changed, only t_max can
+    // have shrunk.
+    let (mut first, mut count) = (root.first, root.count);
+    // Far children left for later: what entering them needs, and where the ray enters their box.
+    let mut stack = [(0u32, 0u32, 0f32); BVH_STACK_SIZE];
+    let mut top = 0usize;
     loop {
-        let node = &nodes[node_index];
-        if node.count > 0 {
-            for i in 0..node.count {
-                let reference = geometry.bvh_primitives[(node.first + i) as usize];
+        if count > 0 {
+            for i in first..first + count {
+                let reference = geometry.bvh_primitives[i as usize];
                 let t = hit_primitive(geometry, reference, r);
                 if t < best.t && reference != shadow_target {
                     best = ClosestPrimitive {
@@ -134,22 +141,27 @@ pub fn bvh_traverse(
                 }
             }
         } else {
-            let left = node.first;
-            let t_left = hit_box(&nodes[left as usize], r, best.t);
-            let t_right = hit_box(&nodes[left as usize + 1], r, best.t);
+            let left = &nodes[first as usize];
+            let right = &nodes[first as usize + 1];
+            let t_left = hit_box(left, r, best.t);
+            let t_right = hit_box(right, r, best.t);
             if t_left != NO_HIT && t_right != NO_HIT {
-                let left_first = t_left <= t_right;
-                stack[top] = if left_first { left + 1 } else { left };
+                let (near, far, t_far) = if t_left <= t_right {
+                    (left, right, t_right)
+                } else {
+                    (right, left, t_left)
+                };
+                stack[top] = (far.first, far.count, t_far);
                 top += 1;
-                node_index = if left_first { left } else { left + 1 } as usize;
+                (first, count) = (near.first, near.count);
                 continue;
             }
             if t_left != NO_HIT {
-                node_index = left as usize;
+                (first, count) = (left.first, left.count);
                 continue;
             }
             if t_right != NO_HIT {
-                node_index = left as usize + 1;
+                (first, count) = (right.first, right.count);
                 continue;
             }
         }
@@ -157,8 +169,9 @@ pub fn bvh_traverse(
         let mut popped = false;
         while top > 0 {
             top -= 1;
-            if hit_box(&nodes[stack[top] as usize], r, best.t) != NO_HIT {
-                node_index = stack[top] as usize;
+            let (node_first, node_count, t_entry) = stack[top];
+            if t_entry <= widened(best.t) {
+                (first, count) = (node_first, node_count);
                 popped = true;
                 break;
             }
