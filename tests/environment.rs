@@ -459,18 +459,8 @@ fn the_cli_rejects_a_bad_map_with_exit_2_and_writes_nothing() {
     )
     .unwrap();
     let out = dir.path().join("out.png");
-    let result = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(["render", "--cpu"])
-        .arg(&scene)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert_eq!(result.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&result.stderr);
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("missing.hdr"), "{stderr}");
-    assert!(!out.exists());
+    let run = common::run_render("--cpu", &scene, &out);
+    common::assert_refused(&run, &out, &["missing.hdr"]);
 }
 
 /// A `width`×`height` Radiance HDR of one colour (run-length encoded, so a map larger than the
@@ -516,19 +506,8 @@ fn a_map_larger_than_the_device_allows_is_refused() {
     )
     .unwrap();
     let out = dir.path().join("out.png");
-    let result = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(["render", "--gpu"])
-        .arg(&scene)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&result.stderr);
-    assert_eq!(result.status.code(), Some(2), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(stderr.contains("environment map"), "{stderr}");
-    assert!(stderr.contains("MiB"), "{stderr}");
-    assert!(!out.exists());
+    let run = common::run_render("--gpu", &scene, &out);
+    common::assert_refused(&run, &out, &["environment map", "MiB"]);
 }
 
 /// The denoiser's albedo guide where a ray escapes is the clamped radiance it sees there: the

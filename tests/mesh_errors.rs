@@ -2,8 +2,9 @@
 //! gives it, the line or element of the mesh file; degenerate triangles are skipped with a
 //! warning. (The CLI's exit code 2 for these is checked at the end.)
 
+mod common;
+
 use glint::scene::Scene;
-use std::path::Path;
 
 const SCENE: &str = r#"[camera]
 eye = [0.0, 0.0, -5.0]
@@ -227,18 +228,8 @@ fn the_cli_exits_with_2_and_writes_nothing() {
     let scene = dir.path().join("scene.toml");
     std::fs::write(&scene, SCENE.replace("MESH", "missing.ply")).unwrap();
     let out = dir.path().join("out.png");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(["render", "--cpu"])
-        .arg(&scene)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert_eq!(status.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&status.stderr);
-    assert!(stderr.contains("missing.ply"), "{stderr}");
-    assert!(!out.exists());
-    assert!(!Path::new(&out).exists());
+    let run = common::run_render("--cpu", &scene, &out);
+    common::assert_refused(&run, &out, &["missing.ply"]);
 }
 
 #[test]
@@ -249,13 +240,7 @@ fn degenerate_triangles_are_skipped_with_one_warning() {
     let scene = dir.path().join("scene.toml");
     std::fs::write(&scene, SCENE.replace("MESH", "t.obj")).unwrap();
     let out = dir.path().join("out.png");
-    let result = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(["render", "--cpu"])
-        .arg(&scene)
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let result = common::run_render("--cpu", &scene, &out);
     assert_eq!(result.status.code(), Some(0));
     let stderr = String::from_utf8_lossy(&result.stderr);
     let warnings: Vec<_> = stderr.lines().filter(|l| l.contains("warning")).collect();

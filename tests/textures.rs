@@ -438,24 +438,8 @@ fn assert_cli_refuses(png: Vec<u8>, device: &str, needles: &[&str]) {
     )
     .ok();
     let out = dir.path().join("out.png");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args(["render", device])
-        .arg(dir.path().join("scene.toml"))
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&run.stderr);
-    assert_eq!(run.status.code(), Some(2), "{stderr}");
-    let lines: Vec<&str> = stderr
-        .lines()
-        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
-        .collect();
-    assert_eq!(lines.len(), 1, "{stderr}");
-    for needle in needles {
-        assert!(lines[0].contains(needle), "{stderr:?} lacks {needle:?}");
-    }
-    assert!(!out.exists());
+    let run = common::run_render(device, &dir.path().join("scene.toml"), &out);
+    common::assert_refused(&run, &out, needles);
 }
 
 #[test]

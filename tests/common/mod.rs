@@ -211,3 +211,30 @@ impl PathAgreement {
         );
     }
 }
+
+/// `glint render DEVICE SCENE -o OUT` (DEVICE is `--cpu` or `--gpu`), run to its end.
+pub fn run_render(device: &str, scene: &Path, out: &Path) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(["render", device])
+        .arg(scene)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .expect("run glint")
+}
+
+/// What a refused render owes its user: exit status 2, one line on stderr (a warning about
+/// XDG_RUNTIME_DIR aside) that holds every needle, and no output file.
+pub fn assert_refused(run: &std::process::Output, out: &Path, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    let lines: Vec<&str> = stderr
+        .lines()
+        .filter(|l| !l.contains("XDG_RUNTIME_DIR"))
+        .collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    for needle in needles {
+        assert!(lines[0].contains(needle), "{stderr:?} lacks {needle:?}");
+    }
+    assert!(!out.exists(), "{} was written", out.display());
+}
