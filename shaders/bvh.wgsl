@@ -3,8 +3,8 @@
 // first, and popped nodes skipped when they start beyond the closest hit so far. Shadow rays
 // stop at the first primitive in front of the one they aim at.
 
-// Enough for any tree the host accepts: it rejects trees deeper than this.
-const BVH_STACK_SIZE: u32 = 64u;
+// The traversal stack's length, BVH_STACK_SIZE, comes from the host with the scene's layout:
+// enough for this scene's tree (kernel_stack_size in src/scene/bvh.rs).
 
 // A ray with what the box and triangle tests share across nodes.
 struct BvhRay {

@@ -52,8 +52,10 @@ pub enum SceneBinding {
     /// Storage buffers traversed through the scene's BVH (`shaders/bvh.wgsl`): scenes with
     /// meshes or many objects, which [`KernelScene::bvh_nodes`] then holds. The first
     /// `uniform_nodes` nodes (the top levels: the tree is laid out breadth first) are also in
-    /// a uniform buffer, which lavapipe reads far faster ([`bvh_uniform_nodes`]).
-    Bvh { uniform_nodes: u32 },
+    /// a uniform buffer, which lavapipe reads far faster ([`bvh_uniform_nodes`]). The
+    /// traversal stack holds `stack_size` entries: enough for the tree
+    /// ([`crate::scene::bvh::kernel_stack_size`]).
+    Bvh { uniform_nodes: u32, stack_size: u32 },
 }
 
 /// How many of the BVH's top nodes the kernel reads from a uniform buffer on a device whose
@@ -114,6 +116,7 @@ impl SceneBinding {
         if !scene.bvh_nodes.is_empty() {
             return SceneBinding::Bvh {
                 uniform_nodes: bvh_uniform_nodes(max_uniform_binding),
+                stack_size: crate::scene::bvh::kernel_stack_size(&scene.bvh_nodes),
             };
         }
         let counts = SceneCounts::of(scene);
@@ -128,7 +131,16 @@ impl SceneBinding {
     /// one, unused, in the layouts without a BVH.
     pub fn uniform_node_count(&self) -> u32 {
         match self {
-            SceneBinding::Bvh { uniform_nodes } => *uniform_nodes,
+            SceneBinding::Bvh { uniform_nodes, .. } => *uniform_nodes,
+            SceneBinding::Storage | SceneBinding::Uniform(_) => 1,
+        }
+    }
+
+    /// The kernel's traversal stack length (`BVH_STACK_SIZE`): one, unused, in the layouts
+    /// without a BVH.
+    pub fn stack_size(&self) -> u32 {
+        match self {
+            SceneBinding::Bvh { stack_size, .. } => *stack_size,
             SceneBinding::Storage | SceneBinding::Uniform(_) => 1,
         }
     }
@@ -146,10 +158,12 @@ impl SceneBinding {
     fn part(&self) -> (&'static str, String) {
         // Triangles exist only in the storage layouts; the uniform one compiles their code out.
         let uniform_nodes = self.uniform_node_count();
+        let stack_size = self.stack_size();
         let storage = |bvh: bool| {
             format!(
                 "const USE_BVH: bool = {bvh};\nconst HAS_TRIANGLES: bool = true;\n\
-                 const BVH_UNIFORM_NODES: u32 = {uniform_nodes}u;\n{SCENE_STORAGE}"
+                 const BVH_UNIFORM_NODES: u32 = {uniform_nodes}u;\n\
+                 const BVH_STACK_SIZE: u32 = {stack_size}u;\n{SCENE_STORAGE}"
             )
         };
         match self {
@@ -161,8 +175,14 @@ impl SceneBinding {
                     "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
                      const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
                      const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n\
-                     const BVH_UNIFORM_NODES: u32 = {}u;\n{}",
-                    c.spheres, c.quads, c.materials, c.emitters, uniform_nodes, SCENE_UNIFORM
+                     const BVH_UNIFORM_NODES: u32 = {}u;\nconst BVH_STACK_SIZE: u32 = {}u;\n{}",
+                    c.spheres,
+                    c.quads,
+                    c.materials,
+                    c.emitters,
+                    uniform_nodes,
+                    stack_size,
+                    SCENE_UNIFORM
                 ),
             ),
         }

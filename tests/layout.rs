@@ -312,6 +312,7 @@ fn every_feature_combination_validates() {
             SceneBinding::Uniform(counts),
             SceneBinding::Bvh {
                 uniform_nodes: 2048,
+                stack_size: 64,
             },
         ] {
             validate_source(render_kernel_source_for(KernelVariant {

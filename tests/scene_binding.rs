@@ -8,6 +8,7 @@ use common::{gpu, render_cpu, shipped_scene, shipped_scene_text, sized};
 use glint::gpu::GpuRenderer;
 use glint::output::Image;
 use glint::render::render_image;
+use glint::scene::bvh::kernel_stack_size;
 use glint::scene::KernelScene;
 use glint::shader::{
     bvh_uniform_nodes, KernelFeatures, KernelVariant, SceneBinding, SceneCounts,
@@ -133,7 +134,8 @@ fn bvh_top_nodes_fill_the_uniform_limit() {
     assert_eq!(
         SceneBinding::for_scene(&bunny, 65536),
         SceneBinding::Bvh {
-            uniform_nodes: 2048
+            uniform_nodes: 2048,
+            stack_size: kernel_stack_size(&bunny.bvh_nodes),
         }
     );
 }
@@ -151,13 +153,25 @@ fn bvh_top_nodes_in_a_uniform_buffer_do_not_change_the_image() {
     assert!(bunny.bvh_nodes.len() > 512, "{}", bunny.bvh_nodes.len());
     let small = sized(shipped_scene("cornell-mesh.toml"), 32, 4);
     for (name, scene) in [("bunny", bunny), ("cornell-mesh", small)] {
-        let storage_only = render_with(&scene, SceneBinding::Bvh { uniform_nodes: 1 }, 2);
+        let stack_size = kernel_stack_size(&scene.bvh_nodes);
+        let storage_only = render_with(
+            &scene,
+            SceneBinding::Bvh {
+                uniform_nodes: 1,
+                stack_size,
+            },
+            2,
+        );
         assert!(
             storage_only.pixels.iter().any(|p| p[0] > 0.0),
             "{name} is black"
         );
         for uniform_nodes in [64, 512, 2048] {
-            let image = render_with(&scene, SceneBinding::Bvh { uniform_nodes }, 2);
+            let binding = SceneBinding::Bvh {
+                uniform_nodes,
+                stack_size,
+            };
+            let image = render_with(&scene, binding, 2);
             let differing = differing_pixels(&storage_only, &image);
             assert_eq!(differing, 0, "{name} with {uniform_nodes} uniform nodes");
         }
@@ -244,4 +258,72 @@ fn a_kernel_lacking_a_needed_feature_is_refused() {
         features,
     };
     assert!(GpuRenderer::with_variant(ctx, &scene, variant).is_err());
+}
+
+/// The longest root-to-leaf path below the root of a tree laid out as `bvh::build` does, by a
+/// recursive walk (the function under test makes one breadth-first pass).
+fn levels_below_root(nodes: &[glint::shader_types::BvhNode], i: usize) -> u32 {
+    let node = nodes[i];
+    if node.count > 0 {
+        return 0;
+    }
+    let first = node.first as usize;
+    1 + levels_below_root(nodes, first).max(levels_below_root(nodes, first + 1))
+}
+
+/// The kernel's traversal stack is sized per scene: room for one entry per level below the
+/// root (the most a traversal holds at once), in steps of 8.
+#[test]
+fn the_traversal_stack_fits_the_tree() {
+    let mut trees: Vec<(String, KernelScene)> = ["bunny.toml", "cornell-mesh.toml"]
+        .iter()
+        .map(|name| (name.to_string(), sized(shipped_scene(name), 8, 0)))
+        .collect();
+    // Deeper trees: the benchmark's bumpy spheres (18 to 30 levels here).
+    for case in glint::bench::mesh_cases(&[1000, 30000], true) {
+        trees.push((
+            format!("{case:?}"),
+            glint::bench::case_scene(&case).unwrap(),
+        ));
+    }
+    for (name, scene) in &trees {
+        let levels = levels_below_root(&scene.bvh_nodes, 0);
+        let stack = kernel_stack_size(&scene.bvh_nodes);
+        assert!(
+            stack >= levels,
+            "{name}: {stack} entries for {levels} levels"
+        );
+        assert!(
+            stack < levels.max(1) + 8,
+            "{name}: {stack} entries for {levels} levels"
+        );
+        assert_eq!(stack % 8, 0, "{name}");
+    }
+}
+
+/// The stack sized for the tree renders what the largest stack renders, bit for bit, while
+/// one too small for the bunny's tree does not, so the comparison can tell. (Traversals rarely
+/// hold many entries at once: at this size 8 entries for the bunny's 18 levels still gives the
+/// same image, 2 do not.)
+#[test]
+fn a_stack_sized_for_the_tree_renders_the_full_stacks_image() {
+    if gpu().is_none() {
+        return;
+    }
+    let bunny = sized(shipped_scene("bunny.toml"), 32, 5);
+    let with_stack = |stack_size| {
+        render_with(
+            &bunny,
+            SceneBinding::Bvh {
+                uniform_nodes: bvh_uniform_nodes(65536),
+                stack_size,
+            },
+            2,
+        )
+    };
+    let full = with_stack(64);
+    let sized_for_tree = kernel_stack_size(&bunny.bvh_nodes);
+    assert!(sized_for_tree < 64, "{sized_for_tree}");
+    assert_eq!(differing_pixels(&full, &with_stack(sized_for_tree)), 0);
+    assert!(differing_pixels(&full, &with_stack(2)) > 0);
 }

@@ -68,6 +68,32 @@ fn reference(i: usize, spheres: usize, quads: usize) -> u32 {
     (kind << PRIMITIVE_KIND_SHIFT) | index as u32
 }
 
+/// The traversal stack's length in the kernel for the tree `nodes` (laid out by [`build`]):
+/// one entry per level below the root, which is the most it can hold at once (the entries'
+/// levels strictly increase from the bottom of the stack up), rounded up to a multiple of 8 so
+/// that few kernels need compiling, and at most the [`BVH_STACK_SIZE`] the host allows.
+/// Why not always the maximum: lavapipe keeps the stack per lane and zero-fills it on every
+/// traversal, and a 24-entry stack instead of 64 renders the bunny 10% faster and a
+/// 1000-triangle mesh 15–25% faster (BENCHMARKS.md).
+pub fn kernel_stack_size(nodes: &[BvhNode]) -> u32 {
+    // Breadth first: a node's children come after it, so one pass finds every level.
+    let mut level = vec![0u32; nodes.len()];
+    let mut deepest = 0;
+    for (i, node) in nodes.iter().enumerate() {
+        if node.count == 0 {
+            let first = node.first as usize;
+            level[first] = level[i] + 1;
+            level[first + 1] = level[i] + 1;
+            deepest = deepest.max(level[i] + 1);
+        }
+    }
+    deepest
+        .div_ceil(8)
+        .max(1)
+        .saturating_mul(8)
+        .min(BVH_STACK_SIZE as u32)
+}
+
 /// Whether a scene gets a BVH rather than the linear scan.
 pub fn wants_bvh(spheres: usize, quads: usize, triangles: usize) -> bool {
     triangles > 0 || spheres + quads > BVH_MIN_PRIMITIVES
