@@ -157,13 +157,16 @@ impl SceneBinding {
     /// The WGSL declaring the scene's bindings, as a named part.
     fn part(&self) -> (&'static str, String) {
         // Triangles exist only in the storage layouts; the uniform one compiles their code out.
-        let uniform_nodes = self.uniform_node_count();
-        let stack_size = self.stack_size();
-        let storage = |bvh: bool| {
+        // The BVH's constants are declared in every layout, since bvh.wgsl is always compiled.
+        let bvh = format!(
+            "const BVH_UNIFORM_NODES: u32 = {}u;\nconst BVH_STACK_SIZE: u32 = {}u;\n",
+            self.uniform_node_count(),
+            self.stack_size()
+        );
+        let storage = |use_bvh: bool| {
             format!(
-                "const USE_BVH: bool = {bvh};\nconst HAS_TRIANGLES: bool = true;\n\
-                 const BVH_UNIFORM_NODES: u32 = {uniform_nodes}u;\n\
-                 const BVH_STACK_SIZE: u32 = {stack_size}u;\n{SCENE_STORAGE}"
+                "const USE_BVH: bool = {use_bvh};\nconst HAS_TRIANGLES: bool = true;\n\
+                 {bvh}{SCENE_STORAGE}"
             )
         };
         match self {
@@ -174,15 +177,8 @@ impl SceneBinding {
                 format!(
                     "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
                      const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
-                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n\
-                     const BVH_UNIFORM_NODES: u32 = {}u;\nconst BVH_STACK_SIZE: u32 = {}u;\n{}",
-                    c.spheres,
-                    c.quads,
-                    c.materials,
-                    c.emitters,
-                    uniform_nodes,
-                    stack_size,
-                    SCENE_UNIFORM
+                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n{bvh}{}",
+                    c.spheres, c.quads, c.materials, c.emitters, SCENE_UNIFORM
                 ),
             ),
         }
