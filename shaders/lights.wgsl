@@ -13,14 +13,23 @@ struct LightSample {
     index: u32,
 }
 
-// Selection by the emitters' cumulative probabilities.
-fn pick_emitter(u: f32) -> u32 {
-    for (var i = 0u; i + 1u < emitter_count(); i++) {
-        if u < emitters[i].cdf {
-            return i;
-        }
+// The emitter light sampling chose: which primitive, and the probability of choosing it.
+struct EmitterChoice {
+    primitive: u32,
+    index: u32,
+    probability: f32,
+}
+
+// Selection in proportion to power, in O(1) by the alias table (src/scene/kernel.rs): u picks
+// the slot, u_alias its emitter or the alias. The slot is floor(u * n) in f32 on both devices
+// (a correctly rounded product, then truncation), so both pick the same emitter.
+fn pick_emitter(u: f32, u_alias: f32) -> EmitterChoice {
+    let n = emitter_count();
+    let slot = emitters[min(u32(u * f32(n)), n - 1u)];
+    if u_alias < slot.alias_threshold {
+        return EmitterChoice(slot.primitive, slot.index, slot.probability);
     }
-    return emitter_count() - 1u;
+    return EmitterChoice(slot.alias_primitive, slot.alias_index, slot.alias_probability);
 }
 
 // Whether an emitter is the environment map; checked before the others, whose tests assume
@@ -98,7 +107,9 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
     if emitter_count() == 0u {
         return out;
     }
-    let e = emitters[pick_emitter(rng_next(rng))];
+    let u_slot = rng_next(rng);
+    let u_alias = rng_next(rng);
+    let e = pick_emitter(u_slot, u_alias);
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     out.primitive = e.primitive;
     out.index = e.index;

@@ -136,12 +136,16 @@ const PRIMITIVE_KIND_SHIFT: u32 = 30u;
 const PRIMITIVE_INDEX_MASK: u32 = 0x3fffffffu;
 
 // One entry per emitting primitive, for choosing one in proportion to its power.
+// One entry per emitter and one slot of the alias table over them (src/shader_types.rs).
 struct Emitter {
     primitive: u32,
     index: u32,
-    // Sum of the selection probabilities up to and including this emitter (the last is 1).
-    cdf: f32,
     probability: f32,
+    alias_threshold: f32,
+    alias_primitive: u32,
+    alias_index: u32,
+    alias_probability: f32,
+    _pad: u32,
 }
 
 const TEXTURE_IMAGE: u32 = 0u;

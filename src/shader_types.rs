@@ -117,15 +117,22 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 pub const PRIMITIVE_SPHERE: u32 = 0;
 pub const PRIMITIVE_QUAD: u32 = 1;
 
-/// One entry per emitting primitive, for choosing one in proportion to its power.
+/// One entry per emitting primitive, and one slot of Vose's alias table over them, for
+/// choosing an emitter in proportion to its power in O(1): slot k keeps its own emitter with
+/// probability `alias_threshold`, else takes the one copied into `alias_*` (copied, not
+/// referred to by index, so a pick reads one entry).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Emitter {
     pub primitive: u32,
     pub index: u32,
-    /// Sum of the selection probabilities up to and including this emitter (the last is 1).
-    pub cdf: f32,
+    /// The probability that light sampling picks this emitter.
     pub probability: f32,
+    pub alias_threshold: f32,
+    pub alias_primitive: u32,
+    pub alias_index: u32,
+    pub alias_probability: f32,
+    pub _pad: u32,
 }
 
 pub const PRIMITIVE_TRIANGLE: u32 = 2;

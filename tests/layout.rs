@@ -157,7 +157,16 @@ fn rust_structs_match_wgsl_layout() {
         &module,
         Emitter,
         "Emitter",
-        [primitive, index, cdf, probability]
+        [
+            primitive,
+            index,
+            probability,
+            alias_threshold,
+            alias_primitive,
+            alias_index,
+            alias_probability,
+            _pad
+        ]
     );
     assert_same_layout!(
         &module,

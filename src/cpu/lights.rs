@@ -22,12 +22,32 @@ pub struct LightSample {
     pub index: u32,
 }
 
-/// Selection by the emitters' cumulative probabilities.
-pub fn pick_emitter(scene: &SceneRefs, u: f32) -> usize {
-    let count = scene.params.emitter_count as usize;
-    (0..count.saturating_sub(1))
-        .find(|&i| u < scene.emitters[i].cdf)
-        .unwrap_or(count - 1)
+/// The emitter light sampling chose: which primitive, and the probability of choosing it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmitterChoice {
+    pub primitive: u32,
+    pub index: u32,
+    pub probability: f32,
+}
+
+/// Selection in proportion to power, in O(1) by the alias table (`src/scene/kernel.rs`): `u`
+/// picks the slot, `u_alias` its emitter or the alias. The slot is ⌊u·n⌋ in f32 on both
+/// devices (a correctly rounded product, then truncation), so both pick the same emitter.
+pub fn pick_emitter(scene: &SceneRefs, u: f32, u_alias: f32) -> EmitterChoice {
+    let n = scene.params.emitter_count;
+    let slot = &scene.emitters[((u * n as f32) as u32).min(n - 1) as usize];
+    if u_alias < slot.alias_threshold {
+        return EmitterChoice {
+            primitive: slot.primitive,
+            index: slot.index,
+            probability: slot.probability,
+        };
+    }
+    EmitterChoice {
+        primitive: slot.alias_primitive,
+        index: slot.alias_index,
+        probability: slot.alias_probability,
+    }
 }
 
 pub fn sphere_contains(s: &Sphere, p: Vec3) -> bool {
@@ -75,7 +95,8 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
     if scene.params.emitter_count == 0 {
         return out;
     }
-    let e = scene.emitters[pick_emitter(scene, rng.next_f32())];
+    let (u_slot, u_alias) = (rng.next_f32(), rng.next_f32());
+    let e = pick_emitter(scene, u_slot, u_alias);
     let u = (rng.next_f32(), rng.next_f32());
     out.primitive = e.primitive;
     out.index = e.index;

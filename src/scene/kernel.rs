@@ -274,7 +274,8 @@ impl Scene {
     }
 
     /// Every emitting primitive with its selection probability, proportional to its power
-    /// (mean emitted radiance × area; the factor π is common to all), and that probability per
+    /// (mean emitted radiance × area; the factor π is common to all), as Vose's alias table
+    /// (the environment map's, [`environment::alias_table`]), and that probability per
     /// sphere, per quad and per triangle (0 for those that do not emit). The environment map,
     /// given its ∫ L dω, emits that through a disc the size of the scene: π R² ∫ L dω, whose π
     /// is dropped as for the others (pbrt's ImageInfiniteLight::Phi).
@@ -335,21 +336,23 @@ impl Scene {
             }
         }
         let total: f64 = powers.iter().map(|p| p.2).sum();
-        let mut cumulative = 0.0;
         let mut emitters: Vec<Emitter> = powers
             .iter()
-            .map(|&(primitive, index, power)| {
-                cumulative += power / total;
-                Emitter {
-                    primitive,
-                    index,
-                    cdf: cumulative as f32,
-                    probability: (power / total) as f32,
-                }
+            .map(|&(primitive, index, power)| Emitter {
+                primitive,
+                index,
+                probability: (power / total) as f32,
+                ..Default::default()
             })
             .collect();
-        if let Some(last) = emitters.last_mut() {
-            last.cdf = 1.0;
+        let weights: Vec<f64> = powers.iter().map(|p| p.2).collect();
+        for (slot, alias) in environment::alias_table(&weights).iter().enumerate() {
+            let other = emitters[alias.alias_texel as usize];
+            let e = &mut emitters[slot];
+            e.alias_threshold = alias.threshold;
+            e.alias_primitive = other.primitive;
+            e.alias_index = other.index;
+            e.alias_probability = other.probability;
         }
         let mut sphere_probability = vec![0.0; self.spheres.len()];
         let mut quad_probability = vec![0.0; self.quads.len()];

@@ -115,3 +115,17 @@ fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = triangle_uv(id.x, vec3<f32>(1.0, 0.0, 0.0));
     probe_out[id.x] = vec4<f32>(texture_lookup(probe.seed, uv), 0.0);
 }
+
+// The emitter choice alone (pick_emitter, from the draws sample_light makes first): the
+// chosen primitive, its index and the probability reported for it.
+@compute @workgroup_size(256, 1, 1)
+fn probe_emitter_choice(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let u_slot = rng_next(&rng);
+    let u_alias = rng_next(&rng);
+    let e = pick_emitter(u_slot, u_alias);
+    probe_out[id.x] = vec4<f32>(f32(e.primitive), f32(e.index), e.probability, 0.0);
+}
