@@ -516,7 +516,10 @@ fn gpu_emitter_choice() {
     check_emitter_choices("gpu emitter choice", &scene, &picks);
     let cpu = cpu_emitter_choices(&kernel, SEED + 43);
     let differ = picks.iter().zip(&cpu).filter(|(g, c)| g != c).count();
-    assert_eq!(differ, 0, "{differ} of {SAMPLES} GPU picks differ from the CPU's");
+    assert_eq!(
+        differ, 0,
+        "{differ} of {SAMPLES} GPU picks differ from the CPU's"
+    );
 }
 
 // ---- Metal (GGX, visible normals) ----------------------------------------------------------
@@ -953,4 +956,81 @@ fn gpu_environment_sampling() {
         );
         check_environment_samples(case, &format!("gpu environment, {}", case.name), &samples);
     }
+}
+
+// ---- Sun disks -------------------------------------------------------------------------------
+
+/// A sun of 2° angular diameter (no other emitter), travelling along `SUN_DIRECTION`.
+const SUN: &str = r#"
+[materials.grey]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+[[spheres]]
+center = [0.0, -50.0, 0.0]
+radius = 1.0
+material = "grey"
+[[lights]]
+type = "directional"
+direction = [0.3, -0.9, 0.2]
+intensity = 2.0
+angle = 2.0
+"#;
+
+/// Sun-disk samples, uniform in the disk's solid angle: (1 − cos θ) / (1 − cos θmax) and
+/// φ / 2π about the axis are then uniform on [0, 1]², which the χ² checks on 32 × 32 cells;
+/// every sample reports the uniform pdf 1 / (2π (1 − cos θmax)) and lies in the cone.
+fn check_sun_samples(name: &str, samples: &[[f32; 4]]) {
+    use glam::DVec3;
+    let axis = -DVec3::new(0.3, -0.9, 0.2).normalize();
+    let half = 1.0f64.to_radians();
+    let one_minus_cos_max = 1.0 - half.cos();
+    let expected_pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+    let (t, b) = {
+        let t = axis.cross(DVec3::Y).normalize();
+        (t, axis.cross(t))
+    };
+    let cells: Vec<[f32; 2]> = samples
+        .iter()
+        .map(|s| {
+            let d = DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64).normalize();
+            assert!(
+                (s[3] as f64 / expected_pdf - 1.0).abs() < 1e-4,
+                "{name}: pdf {} vs {expected_pdf}",
+                s[3]
+            );
+            let one_minus_cos = 0.5 * (d - axis).length_squared();
+            let u = one_minus_cos / one_minus_cos_max;
+            assert!(u <= 1.0 + 1e-3, "{name}: {d} is outside the disk ({u})");
+            let phi = d.dot(b).atan2(d.dot(t)).rem_euclid(2.0 * PI) / (2.0 * PI);
+            [u.min(0.999_999) as f32, (phi as f32).min(0.999_999)]
+        })
+        .collect();
+    assert_fits(name, &Ok(uniform_2d(&cells, 32)));
+}
+
+#[test]
+fn cpu_sun_disk_sampling() {
+    let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
+    let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
+    let samples: Vec<[f32; 4]> = (0..SAMPLES)
+        .map(|i| {
+            let mut r = cpu_draws(i, SEED + 51);
+            let s = glint::cpu::lights::sample_light(&refs, Vec3::ZERO, Vec3::ZERO, &mut r);
+            [s.dir.x, s.dir.y, s.dir.z, s.pdf]
+        })
+        .collect();
+    check_sun_samples("cpu sun disk", &samples);
+}
+
+#[test]
+fn gpu_sun_disk_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
+    let samples = run_probe(
+        ctx,
+        "probe_light",
+        probe(Vec3::Z, SAMPLES, SEED + 53),
+        &kernel,
+    );
+    check_sun_samples("gpu sun disk", &samples);
 }

@@ -10,6 +10,7 @@ pub mod environment;
 pub mod intersect;
 pub mod lights;
 pub mod material;
+pub mod punctual;
 pub mod renderer;
 pub mod rng;
 pub mod surface;

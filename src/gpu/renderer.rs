@@ -207,6 +207,7 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.environment_alias),
                     read_only,
                 ),
+                BufferNeed::new("lights", array_bytes(&scene.lights), read_only),
                 BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
@@ -243,6 +244,7 @@ impl<'a> GpuRenderer<'a> {
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
+        let lights = storage_buffer(ctx, "lights", &scene.lights);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -305,6 +307,7 @@ impl<'a> GpuRenderer<'a> {
                 (22, read_only, &triangle_uvs),
                 (18, read_only, &environment_texels),
                 (19, read_only, &environment_alias),
+                (24, read_only, &lights),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

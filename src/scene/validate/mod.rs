@@ -4,6 +4,7 @@
 
 mod environment;
 mod fields;
+mod lights;
 mod materials;
 mod objects;
 
@@ -179,6 +180,7 @@ impl SceneToml {
             triangles: objects.triangles,
             textures: materials.textures,
             environment,
+            lights: lights::validate_lights(&self.lights)?,
         };
         Ok((scene, objects.warnings))
     }
