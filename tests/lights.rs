@@ -296,6 +296,19 @@ fn bad_lights_are_errors_naming_the_field() {
             "",
             &["lights[0].direction", "missing"][..],
         ),
+        (
+            "type = \"spot\"\nposition = [0.0, 3.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\n\
+             intensity = 10.0\ninner_angle = 10.0\nouter_angle = 30.0",
+            "type = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nintensity = 1e9\n\
+             angle = 0.001",
+            &["lights[0].angle", "radiance"][..],
+        ),
+        (
+            "type = \"spot\"\nposition = [0.0, 3.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\n\
+             intensity = 10.0\ninner_angle = 10.0\nouter_angle = 30.0",
+            "type = \"point\"\nposition = [0.0, 3.0, 0.0]\nintensity = 10.0\nradius = 1e-7",
+            &["lights[0].radius", "radiance"][..],
+        ),
     ] {
         assert!(GOOD_LIGHT.contains(from), "{from}");
         let text = GOOD_LIGHT.replacen(from, to, 1);

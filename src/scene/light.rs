@@ -56,6 +56,18 @@ impl Light {
         }
     }
 
+    /// A sun disk's radiance: a disk of half-angle θ and uniform radiance L gives, on a
+    /// surface facing it, E = L·π sin²θ. `None` for other lights and suns without a disk.
+    pub fn sun_radiance(&self) -> Option<glam::Vec3> {
+        match self.kind {
+            LightKind::Directional { angle, .. } if angle > 0.0 => {
+                let half = 0.5 * (angle as f64).to_radians();
+                Some((self.emitted() / (std::f64::consts::PI * half.sin().powi(2))).as_vec3())
+            }
+            _ => None,
+        }
+    }
+
     /// Power over π (the π every emitter's power shares is dropped, as in
     /// `src/scene/kernel.rs`), channels averaged; `scene_radius` sizes a sun's disc of light.
     /// A point light radiates 4πI; a spot 2πI·((1 − cos inner) + (cos inner − cos outer)/2),
@@ -114,14 +126,13 @@ impl Light {
             LightKind::Directional { direction, angle } => {
                 out.kind = LIGHT_SUN;
                 out.direction = direction.into();
-                if angle > 0.0 {
-                    // A disk of half-angle θ: uniform radiance L gives, on a surface facing
-                    // it, E = L·π sin²θ. 1 − cos θ = 2 sin²(θ/2), without cancellation.
-                    let half = 0.5 * (angle as f64).to_radians();
-                    out.sun_one_minus_cos = (2.0 * (0.5 * half).sin().powi(2)) as f32;
-                    out.emitted = (emitted / (std::f64::consts::PI * half.sin().powi(2)))
-                        .as_vec3()
-                        .into();
+                // 1 − cos θ = 2 sin²(θ/2), without cancellation. A disk too small for a normal
+                // f32 (GPUs flush subnormals to zero) is a delta sun on both devices.
+                let half = 0.5 * (angle as f64).to_radians();
+                let one_minus_cos = (2.0 * (0.5 * half).sin().powi(2)) as f32;
+                if one_minus_cos >= f32::MIN_POSITIVE {
+                    out.sun_one_minus_cos = one_minus_cos;
+                    out.emitted = self.sun_radiance().unwrap_or_default().into();
                 }
             }
         }

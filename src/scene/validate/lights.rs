@@ -168,9 +168,30 @@ fn validate_light(l: &LightToml, i: usize) -> Result<Light, FieldError> {
             angle: angle(&l.angle, "angle", 0.0, 90.0)?,
         },
     };
-    Ok(Light {
+    let light = Light {
         kind,
         color,
         intensity,
-    })
+    };
+    // A sphere light's or a sun disk's radiance grows as the radius or the angle shrinks:
+    // it must stay in the numeric range emission has.
+    let surface = light
+        .sphere()
+        .map(|(_, _, radiance)| ("radius", radiance, l.radius.as_ref()))
+        .or_else(|| light.sun_radiance().map(|r| ("angle", r, l.angle.as_ref())));
+    if let Some((name, radiance, Some(x))) = surface {
+        let peak = radiance.max_element() as f64;
+        if peak > MAX_RADIANCE || peak.is_nan() {
+            return fail(
+                x.span(),
+                field(name),
+                format!(
+                    "the light's surface would have a radiance of {peak:e}: at most \
+                     {MAX_RADIANCE:e} (the numeric range glint supports); make it larger or \
+                     dimmer"
+                ),
+            );
+        }
+    }
+    Ok(light)
 }
