@@ -187,7 +187,8 @@ fn intersect_scene(ray: Ray) -> Hit {
     hit.normal = select(-outward, outward, hit.front_face);
     hit.shading_normal = hit.normal;
     if HAS_TRIANGLES && any(shading != vec3<f32>(0.0)) {
-        hit.shading_normal = select(-shading, shading, dot(shading, hit.normal) >= 0.0);
+        let facing = select(-shading, shading, dot(shading, hit.normal) >= 0.0);
+        hit.shading_normal = valid_shading_normal(hit.normal, -ray.dir, facing);
     }
     return hit;
 }

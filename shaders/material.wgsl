@@ -138,10 +138,15 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> vec3<f3
     if is_metal(m) {
         let wo_l = to_local(wo, n);
         let wi_l = to_local(wi, n);
+        // wo below the normal: sampling never returns such pairs (their pdf is 0), so neither
+        // may light sampling (valid_shading_normal keeps wo above it but for rounding).
+        if wo_l.z <= 0.0 {
+            return vec3<f32>(0.0);
+        }
         let h = normalize(wo_l + wi_l);
         let g2 = 1.0 / (1.0 + ggx_lambda(wo_l, m.alpha) + ggx_lambda(wi_l, m.alpha));
         let f = fresnel_schlick(m.albedo, dot(wo_l, h));
-        return f * (ggx_d(h.z, m.alpha) * g2 / (4.0 * max(wo_l.z, 1e-12)));
+        return f * (ggx_d(h.z, m.alpha) * g2 / (4.0 * wo_l.z));
     }
     return m.albedo * (cos_i / PI);
 }
@@ -197,8 +202,10 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: 
         let wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
         out.is_delta = false;
         out.dir = normalize(from_local(wi_l, n));
-        if wi_l.z <= 0.0 {
-            // Reflected below the surface: the single-scattering model absorbs it.
+        if wi_l.z <= 0.0 || wo_l.z <= 0.0 {
+            // Reflected below the surface (or seen from below the normal, which
+            // valid_shading_normal prevents but for rounding): the single-scattering model
+            // absorbs it.
             out.weight = vec3<f32>(0.0);
             return out;
         }

@@ -8,11 +8,15 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 15] = [
+pub const SHADER_PARTS: [(&str, &str); 16] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
+    (
+        "shading_normal.wgsl",
+        include_str!("../shaders/shading_normal.wgsl"),
+    ),
     ("triangle.wgsl", include_str!("../shaders/triangle.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),

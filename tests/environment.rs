@@ -3,28 +3,13 @@
 //! sampling, and bad input. The sampler's own χ² tests are in tests/chi2.rs.
 
 mod common;
-use common::{largest_deviation, render_both, PathAgreement};
+use common::{largest_deviation, render_both, with_light_sampling, write_map, PathAgreement};
 use glint::compare::compare;
 use glint::cpu::renderer::CpuRenderer;
 use glint::output::Image;
 use glint::render::render_image;
-use glint::scene::{KernelScene, RenderOverrides, Scene};
-use std::path::{Path, PathBuf};
-
-/// Writes a `width`×`height` EXR map with texels `texel(x, y)` (top row first) into `dir`.
-fn write_map(
-    dir: &Path,
-    name: &str,
-    width: u32,
-    height: u32,
-    texel: impl Fn(u32, u32) -> [f32; 3],
-) -> PathBuf {
-    let path = dir.join(name);
-    image::Rgb32FImage::from_fn(width, height, |x, y| image::Rgb(texel(x, y)))
-        .save(&path)
-        .unwrap();
-    path
-}
+use glint::scene::{KernelScene, Scene};
+use std::path::Path;
 
 /// A scene file's text: `camera`, `render` lines, then `rest`, in `dir` as scene.toml.
 fn scene_in(dir: &Path, text: &str) -> Scene {
@@ -39,18 +24,6 @@ fn header(eye: [f32; 3], target: [f32; 3], vfov: f32, size: u32, bounces: u32) -
          [render]\nwidth = {size}\nheight = {size}\nspp = 1\nmax_bounces = {bounces}\n\
          russian_roulette = false\n"
     )
-}
-
-fn with_light_sampling(scene: &Scene, on: bool, seed: u32) -> KernelScene {
-    scene
-        .clone()
-        .with_overrides(&RenderOverrides {
-            light_sampling: Some(on),
-            seed: Some(seed),
-            ..Default::default()
-        })
-        .unwrap()
-        .kernel_scene()
 }
 
 /// Renders on the CPU and, where there is one, the GPU, with variance images.

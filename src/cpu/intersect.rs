@@ -1,6 +1,7 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
 use super::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
+use super::shading_normal::valid_shading_normal;
 use super::surface::{parametric_point, sphere_point};
 use super::texture::{sphere_uv, triangle_uv};
 use super::triangle::{
@@ -263,11 +264,12 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
     let front_face = outward.dot(ray.dir) < 0.0;
     let normal = if front_face { outward } else { -outward };
     let shading_normal = if shading != Vec3::ZERO {
-        if shading.dot(normal) >= 0.0 {
+        let facing = if shading.dot(normal) >= 0.0 {
             shading
         } else {
             -shading
-        }
+        };
+        valid_shading_normal(normal, -ray.dir, facing)
     } else {
         normal
     };

@@ -140,10 +140,15 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
     if m.kind == MATERIAL_METAL {
         let wo_l = to_local(wo, n);
         let wi_l = to_local(wi, n);
+        // wo below the normal: sampling never returns such pairs (their pdf is 0), so neither
+        // may light sampling (valid_shading_normal keeps wo above it but for rounding).
+        if wo_l.z <= 0.0 {
+            return Vec3::ZERO;
+        }
         let h = (wo_l + wi_l).normalize();
         let g2 = 1.0 / (1.0 + ggx_lambda(wo_l, m.alpha) + ggx_lambda(wi_l, m.alpha));
         let f = fresnel_schlick(Vec3::from(m.albedo), wo_l.dot(h));
-        return f * (ggx_d(h.z, m.alpha) * g2 / (4.0 * wo_l.z.max(1e-12)));
+        return f * (ggx_d(h.z, m.alpha) * g2 / (4.0 * wo_l.z));
     }
     Vec3::from(m.albedo) * (cos_i / PI)
 }
@@ -197,8 +202,10 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, n: Vec3, front_face: bool, rng: &mut 
         let h = sample_ggx_visible_normal(wo_l, m.alpha, u);
         let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
         let dir = from_local(wi_l, n).normalize();
-        if wi_l.z <= 0.0 {
-            // Reflected below the surface: the single-scattering model absorbs it.
+        if wi_l.z <= 0.0 || wo_l.z <= 0.0 {
+            // Reflected below the surface (or seen from below the normal, which
+            // valid_shading_normal prevents but for rounding): the single-scattering model
+            // absorbs it.
             return BsdfSample {
                 dir,
                 weight: Vec3::ZERO,

@@ -12,6 +12,7 @@ pub mod lights;
 pub mod material;
 pub mod renderer;
 pub mod rng;
+pub mod shading_normal;
 pub mod surface;
 pub mod texture;
 pub mod trace;
