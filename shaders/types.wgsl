@@ -189,7 +189,8 @@ struct Ray {
     dir: vec3<f32>,
 }
 
-@group(0) @binding(0) var<uniform> params: Params;
+// Binding 0, params: Params, is declared by the host, in a uniform or a storage buffer
+// (src/gpu/inline_uniforms.rs says why).
 // The scene's objects (bindings 1, 2, 3 and 6) are declared by scene_storage.wgsl or
 // scene_uniform.wgsl, whichever the host chose (src/shader.rs).
 // Per pixel, over all samples so far: the mean radiance (xyz; w unused) and M2, the sum of

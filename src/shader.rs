@@ -307,13 +307,40 @@ pub fn render_kernel_source() -> String {
     render_kernel_source_for(KernelVariant::GENERAL)
 }
 
-/// The whole kernel as one WGSL module, in the given variant.
+/// Where the kernel reads its `Params` from (src/gpu/inline_uniforms.rs chooses per device).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamsBinding {
+    Uniform,
+    /// A read-only storage buffer, whose values drivers never compile into the kernel.
+    Storage,
+}
+
+impl ParamsBinding {
+    /// The WGSL address space of the declaration.
+    pub fn address_space(&self) -> &'static str {
+        match self {
+            ParamsBinding::Uniform => "uniform",
+            ParamsBinding::Storage => "storage, read",
+        }
+    }
+}
+
+/// The whole kernel as one WGSL module, in the given variant, with `Params` in a uniform buffer.
 pub fn render_kernel_source_for(variant: KernelVariant) -> String {
+    render_kernel_source_with(variant, ParamsBinding::Uniform)
+}
+
+/// The whole kernel as one WGSL module, in the given variant, with `Params` bound as `params`.
+pub fn render_kernel_source_with(variant: KernelVariant, params: ParamsBinding) -> String {
     let (scene_name, scene_text) = variant.binding.part();
     let mut source = String::new();
     for (i, (name, text)) in SHADER_PARTS.iter().enumerate() {
         source += &format!("// ---- {name}\n{text}\n");
         if i == 0 {
+            source += &format!(
+                "// ---- params\n@group(0) @binding(0) var<{}> params: Params;\n",
+                params.address_space()
+            );
             source += &format!("// ---- features\n{}\n", variant.features.part());
             source += &format!("// ---- {scene_name}\n{scene_text}\n");
         }
