@@ -8,7 +8,7 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 16] = [
+pub const SHADER_PARTS: [(&str, &str); 22] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -20,6 +20,18 @@ pub const SHADER_PARTS: [(&str, &str); 16] = [
     ("triangle.wgsl", include_str!("../shaders/triangle.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
+    ("frame.wgsl", include_str!("../shaders/frame.wgsl")),
+    ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
+    (
+        "microfacet.wgsl",
+        include_str!("../shaders/microfacet.wgsl"),
+    ),
+    ("diffuse.wgsl", include_str!("../shaders/diffuse.wgsl")),
+    ("conductor.wgsl", include_str!("../shaders/conductor.wgsl")),
+    (
+        "dielectric.wgsl",
+        include_str!("../shaders/dielectric.wgsl"),
+    ),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
     (

@@ -6,7 +6,7 @@ mod common;
 use common::chi2::{assert_fits, directions, directions_integrated, pearson, uniform_2d};
 use common::probe::{run_probe, ProbeParams};
 use glam::Vec3;
-use glint::cpu::material::sample_cosine_hemisphere;
+use glint::cpu::diffuse::sample_cosine_hemisphere;
 use glint::cpu::rng::Rng;
 use std::f64::consts::PI;
 

@@ -5,7 +5,7 @@
 //! unit solid angle at the shading point and include the selection probability.
 
 use super::environment::{environment_pdf, sample_environment};
-use super::material::{basis, PI};
+use super::frame::{basis, PI};
 use super::rng::Rng;
 use super::trace::SceneRefs;
 use super::triangle::{triangle_normal, triangle_plane_distance, triangle_point};

@@ -4,12 +4,18 @@
 
 pub mod accumulate;
 pub mod aov;
+pub mod bsdf;
 pub mod bvh;
 pub mod camera;
+pub mod conductor;
+pub mod dielectric;
+pub mod diffuse;
 pub mod environment;
+pub mod frame;
 pub mod intersect;
 pub mod lights;
 pub mod material;
+pub mod microfacet;
 pub mod renderer;
 pub mod rng;
 pub mod shading_normal;
