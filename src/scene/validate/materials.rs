@@ -1,0 +1,305 @@
+//! `[materials.NAME]`: each material's kind, colour, emission and textures, and references to
+//! materials by name.
+
+use super::super::file::{MaterialToml, Real, RoughnessToml, S};
+use super::super::limits::{MAX_IOR, MIN_IOR};
+use super::super::texture::{TextureSet, TextureUse};
+use super::super::{Material, MaterialKind};
+use super::fields::{fail, non_negative, radiance_in_range, real, vec3, FieldError};
+use glam::Vec3;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The scene's materials (mesh files add their own), the textures they use, and their indices
+/// by name.
+pub(super) struct Materials {
+    pub(super) list: Vec<Material>,
+    pub(super) textures: TextureSet,
+    index_of: BTreeMap<String, u32>,
+}
+
+impl Materials {
+    /// The index of the material `m` names; an unknown name fails at `field`.
+    pub(super) fn reference(&self, m: &S<String>, field: String) -> Result<u32, FieldError> {
+        self.index_of.get(m.get_ref()).copied().ok_or_else(|| {
+            let known: Vec<_> = self.index_of.keys().map(|k| format!("{k:?}")).collect();
+            FieldError {
+                span: Some(m.span()),
+                field,
+                message: format!(
+                    "unknown material {:?}; defined materials: {}",
+                    m.get_ref(),
+                    if known.is_empty() {
+                        "none".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            }
+        })
+    }
+}
+
+/// The `[materials]` tables, with textures read relative to `folder`.
+pub(super) fn validate_materials(
+    toml: &BTreeMap<String, S<MaterialToml>>,
+    folder: &Path,
+) -> Result<Materials, FieldError> {
+    let mut materials = Vec::new();
+    let mut textures = TextureSet::default();
+    let mut index_of = BTreeMap::new();
+    for (name, m) in toml {
+        let m = m.get_ref();
+        let field = |f: &str| format!("materials.{name}.{f}");
+        let positive =
+            |x: &Option<S<Real>>, name: &str, what: &str| -> Result<f32, FieldError> {
+                let Some(x) = x else {
+                    return fail(
+                        m.kind.span(),
+                        field(name),
+                        format!("missing: a {what} needs {name}"),
+                    );
+                };
+                real(x, &field(name))
+            };
+        let kind = match m.kind.get_ref().as_str() {
+            "diffuse" => MaterialKind::Diffuse,
+            "specular" => MaterialKind::Specular,
+            "metal" => {
+                let Some(r) = &m.roughness else {
+                    return fail(
+                        m.kind.span(),
+                        field("roughness"),
+                        "missing: a metal needs roughness",
+                    );
+                };
+                let roughness = match r.get_ref() {
+                    RoughnessToml::Value(v) => {
+                        real(&S::new(r.span(), *v), &field("roughness"))?
+                    }
+                    // A texture (read below); the constant is unused.
+                    RoughnessToml::Other(_) => 1.0,
+                };
+                if !(0.0..=1.0).contains(&roughness) {
+                    return fail(
+                        r.span(),
+                        field("roughness"),
+                        format!("must be in [0, 1] (0 = mirror), got {roughness}"),
+                    );
+                }
+                MaterialKind::Metal { roughness }
+            }
+            "dielectric" => {
+                let ior = positive(&m.ior, "ior", "dielectric")?;
+                if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+                    return fail(
+                        m.ior.as_ref().unwrap().span(),
+                        field("ior"),
+                        format!(
+                            "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
+                             numeric range glint supports), got {ior}"
+                        ),
+                    );
+                }
+                MaterialKind::Dielectric { ior }
+            }
+            other => {
+                return fail(
+                    m.kind.span(),
+                    field("type"),
+                    format!(
+                        "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\""
+                    ),
+                )
+            }
+        };
+        // A field that does not apply is most likely a mistake: say so.
+        for (span, name, applies) in [
+            (
+                m.roughness.as_ref().map(|r| r.span()),
+                "roughness",
+                matches!(kind, MaterialKind::Metal { .. }),
+            ),
+            (
+                m.ior.as_ref().map(|r| r.span()),
+                "ior",
+                matches!(kind, MaterialKind::Dielectric { .. }),
+            ),
+        ] {
+            if let (Some(span), false) = (span, applies) {
+                return fail(
+                    span,
+                    field(name),
+                    format!("{name} does not apply to a {} material", m.kind.get_ref()),
+                );
+            }
+        }
+        let roughness_texture = match &m.roughness {
+            Some(r) => match r.get_ref() {
+                RoughnessToml::Other(value) => Some(texture(
+                    &S::new(r.span(), value.clone()),
+                    &field("roughness"),
+                    folder,
+                    TextureUse::Roughness,
+                    &mut textures,
+                )?),
+                RoughnessToml::Value(_) => None,
+            },
+            None => None,
+        };
+        let color_texture = match &m.color {
+            Some(c) if c.get_ref().is_table() => Some(texture(
+                c,
+                &field("color"),
+                folder,
+                TextureUse::Color,
+                &mut textures,
+            )?),
+            _ => None,
+        };
+        let color = match (&m.color, kind) {
+            // Textured: the constant is unused.
+            (Some(_), _) if color_texture.is_some() => Vec3::ONE,
+            (Some(c), _) => {
+                let color = non_negative(c, &field("color"))?;
+                if color.max_element() > 1.0 {
+                    return fail(
+                        c.span(),
+                        field("color"),
+                        format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
+                    );
+                }
+                color
+            }
+            // Clear glass unless tinted.
+            (None, MaterialKind::Dielectric { .. }) => Vec3::ONE,
+            (None, _) => {
+                return fail(
+                    m.kind.span(),
+                    field("color"),
+                    "missing: this material needs a color",
+                );
+            }
+        };
+        let emission =
+            match &m.emission {
+                Some(e) if e.get_ref().is_table() => return fail(
+                    e.span(),
+                    field("emission"),
+                    "takes no texture: only color (and a metal's roughness) may be textured",
+                ),
+                Some(e) => non_negative(e, &field("emission"))?,
+                None => Vec3::ZERO,
+            };
+        let strength = match &m.strength {
+            Some(s) => {
+                let v = real(s, &field("strength"))?;
+                if v < 0.0 {
+                    return fail(s.span(), field("strength"), format!("must be ≥ 0, got {v}"));
+                }
+                v
+            }
+            None => 1.0,
+        };
+        // Each factor may be in range and the product not (1e30 × 1e30): check the product,
+        // in f64, where it is exact enough and cannot overflow.
+        if let Some(e) = &m.emission {
+            let span = m.strength.as_ref().map_or(e.span(), |s| s.span());
+            radiance_in_range(
+                span,
+                &field("emission × strength"),
+                emission.as_dvec3() * strength as f64,
+            )?;
+        }
+        index_of.insert(name.clone(), materials.len() as u32);
+        materials.push(Material {
+            name: name.clone(),
+            kind,
+            color,
+            emitted_radiance: emission * strength,
+            color_texture,
+            roughness_texture,
+        });
+    }
+    Ok(Materials {
+        list: materials,
+        textures,
+        index_of,
+    })
+}
+
+/// A texture as written in a material field: `{ texture = "file" }` (relative to `folder`) or
+/// `{ checker = [[r, g, b], [r, g, b]], scale = s }` (scale optional, default 1). Returns its
+/// index in `textures`.
+fn texture(
+    x: &S<toml::Value>,
+    field: &str,
+    folder: &Path,
+    usage: TextureUse,
+    textures: &mut TextureSet,
+) -> Result<u32, FieldError> {
+    let expected = "must be a constant, { texture = \"file.png\" } or { checker = [[r, g, b], [r, g, b]], scale = s }";
+    let Some(table) = x.get_ref().as_table() else {
+        return fail(x.span(), field, format!("{expected}, got {}", x.get_ref()));
+    };
+    let keys: Vec<&str> = table.keys().map(|k| k.as_str()).collect();
+    match keys.as_slice() {
+        ["texture"] => {
+            let Some(file) = table["texture"].as_str() else {
+                return fail(x.span(), field, "texture must be a file name (a string)");
+            };
+            textures
+                .image(&folder.join(file), usage)
+                .or_else(|message| fail(x.span(), field, format!("{file}: {message}")))
+        }
+        ["checker"] | ["checker", "scale"] | ["scale", "checker"] => {
+            let colors = match table["checker"].as_array() {
+                Some(c) if c.len() == 2 => c,
+                _ => {
+                    return fail(
+                        x.span(),
+                        field,
+                        "checker must be two colors [[r, g, b], [r, g, b]]",
+                    )
+                }
+            };
+            let mut pair = [Vec3::ZERO; 2];
+            for (out, c) in pair.iter_mut().zip(colors) {
+                let color = vec3(&S::new(x.span(), c.clone()), &format!("{field}.checker"))?;
+                if color.min_element() < 0.0 || color.max_element() > 1.0 {
+                    return fail(
+                        x.span(),
+                        format!("{field}.checker"),
+                        format!("every value must be in [0, 1], got {color}"),
+                    );
+                }
+                *out = color;
+            }
+            let scale = match table.get("scale") {
+                None => 1.0,
+                Some(toml::Value::Float(v)) => *v,
+                Some(toml::Value::Integer(v)) => *v as f64,
+                Some(other) => {
+                    return fail(
+                        x.span(),
+                        format!("{field}.scale"),
+                        format!("must be a number, got {other}"),
+                    )
+                }
+            };
+            if !(scale > 0.0 && scale <= 1e6) {
+                return fail(
+                    x.span(),
+                    format!("{field}.scale"),
+                    format!("must be in (0, 1e6] squares per unit of u and v, got {scale}"),
+                );
+            }
+            Ok(textures.checker(pair, scale as f32))
+        }
+        _ => fail(
+            x.span(),
+            field,
+            format!("{expected}; unknown keys: {}", keys.join(", ")),
+        ),
+    }
+}

@@ -1,0 +1,185 @@
+//! From the file as written to a validated [`Scene`]: every range, reference and degenerate
+//! case checked, each failure tied to its field and its place in the file. The camera and the
+//! render settings are checked here; each other part of the file in its own module.
+
+mod environment;
+mod fields;
+mod materials;
+mod objects;
+
+pub(super) use fields::FieldError;
+
+use super::file::SceneToml;
+use super::limits::{MIN_LENGTH, MIN_SINE};
+use super::{
+    check_image_size, Camera, RenderSettings, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
+use fields::{
+    coordinates, fail, int_in, length_in_range, non_negative, radiance_in_range, real,
+    sine_between, vec3,
+};
+use glam::Vec3;
+use std::path::Path;
+
+impl SceneToml {
+    /// The scene, and warnings to print; mesh files are read relative to `folder`.
+    pub(super) fn validate(
+        self,
+        name: String,
+        folder: &Path,
+    ) -> Result<(Scene, Vec<String>), FieldError> {
+        let whole = |field: &str, message: String| FieldError {
+            span: None,
+            field: field.into(),
+            message,
+        };
+        let camera = self.camera.ok_or_else(|| {
+            whole(
+                "[camera]",
+                "missing: the scene needs a [camera] table".into(),
+            )
+        })?;
+        let camera = camera.into_inner();
+        let render = self.render.ok_or_else(|| {
+            whole(
+                "[render]",
+                "missing: the scene needs a [render] table".into(),
+            )
+        })?;
+        let render_span = render.span();
+        let render = render.into_inner();
+
+        let eye = coordinates(&camera.eye, "camera.eye")?;
+        let target = coordinates(&camera.target, "camera.target")?;
+        let up = vec3(&camera.up, "camera.up")?;
+        let vfov = real(&camera.vfov, "camera.vfov")?;
+        if !(vfov > 0.0 && vfov < 180.0) {
+            return fail(
+                camera.vfov.span(),
+                "camera.vfov",
+                format!("must be in (0, 180) degrees, got {vfov}"),
+            );
+        }
+        let view = target - eye;
+        if view.as_dvec3().length() == 0.0 {
+            return fail(
+                camera.target.span(),
+                "camera.target",
+                "must differ from camera.eye (the view direction is target − eye)",
+            );
+        }
+        if up == Vec3::ZERO || sine_between(up, view) <= MIN_SINE {
+            return fail(
+                camera.up.span(),
+                "camera.up",
+                format!(
+                    "must not be zero or parallel to the view direction {}",
+                    view.normalize()
+                ),
+            );
+        }
+        let aperture = match &camera.aperture {
+            Some(a) => {
+                let v = real(a, "camera.aperture")?;
+                if v < 0.0 {
+                    return fail(
+                        a.span(),
+                        "camera.aperture",
+                        format!("the lens diameter must be ≥ 0, got {v}"),
+                    );
+                }
+                length_in_range(a, "camera.aperture", v, 0.0)?
+            }
+            None => 0.0,
+        };
+        let focus_distance = match &camera.focus_distance {
+            Some(f) => {
+                let v = real(f, "camera.focus_distance")?;
+                if v <= 0.0 {
+                    return fail(
+                        f.span(),
+                        "camera.focus_distance",
+                        format!("must be > 0, got {v}"),
+                    );
+                }
+                length_in_range(f, "camera.focus_distance", v, MIN_LENGTH)?
+            }
+            None => view.as_dvec3().length() as f32,
+        };
+
+        let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
+        check_image_size(width, height).or_else(|m| {
+            let span = if width < 1 || width > MAX_IMAGE_SIDE as i64 {
+                render.width.span()
+            } else if height < 1 || height > MAX_IMAGE_SIDE as i64 {
+                render.height.span()
+            } else {
+                render_span.clone()
+            };
+            fail(span, "render", m)
+        })?;
+        let spp = int_in(&render.spp, "render.spp", 1, MAX_SPP as i64)?;
+        let max_bounces = int_in(
+            &render.max_bounces,
+            "render.max_bounces",
+            0,
+            MAX_BOUNCES_LIMIT as i64,
+        )?;
+        let background = match &render.background {
+            Some(b) => {
+                let v = non_negative(b, "render.background")?;
+                radiance_in_range(b.span(), "render.background", v.as_dvec3())?;
+                v
+            }
+            None => Vec3::ZERO,
+        };
+        let seed = match &render.seed {
+            Some(s) => int_in(s, "render.seed", 0, u32::MAX as i64)?,
+            None => 0,
+        };
+        let mut materials = materials::validate_materials(&self.materials, folder)?;
+        let objects = objects::validate_objects(
+            &self.spheres,
+            &self.quads,
+            &self.meshes,
+            folder,
+            &mut materials,
+        )?;
+        let environment = match &self.environment {
+            Some(e) => Some(environment::validate_environment(
+                e,
+                render.background.is_some(),
+                folder,
+            )?),
+            None => None,
+        };
+        let scene = Scene {
+            name,
+            camera: Camera {
+                eye,
+                target,
+                up,
+                vfov,
+                aperture,
+                focus_distance,
+            },
+            render: RenderSettings {
+                width: width as u32,
+                height: height as u32,
+                spp,
+                max_bounces,
+                background,
+                seed,
+                light_sampling: render.light_sampling.unwrap_or(true),
+                russian_roulette: render.russian_roulette.unwrap_or(true),
+            },
+            materials: materials.list,
+            spheres: objects.spheres,
+            quads: objects.quads,
+            triangles: objects.triangles,
+            textures: materials.textures,
+            environment,
+        };
+        Ok((scene, objects.warnings))
+    }
+}
