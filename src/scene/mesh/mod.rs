@@ -11,9 +11,9 @@ mod obj;
 mod ply;
 
 use super::texture::{TextureSet, TextureUse};
-use super::{Material, MaterialKind, Triangle};
+use super::{Material, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
-use glam::{Mat3, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};
 
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
