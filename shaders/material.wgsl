@@ -1,5 +1,5 @@
 // The BSDF of each material kind, dispatched to its lobes (mirror: src/cpu/material.rs):
-// diffuse.wgsl, conductor.wgsl, dielectric.wgsl, on microfacet.wgsl and frame.wgsl.
+// diffuse.wgsl, conductor.wgsl, dielectric.wgsl, pbr.wgsl, on microfacet.wgsl and frame.wgsl.
 
 // Material kinds a scene lacks are compiled out (HAS_*, see src/shader.rs).
 fn is_metal(m: Material) -> bool {
@@ -8,6 +8,10 @@ fn is_metal(m: Material) -> bool {
 
 fn is_dielectric(m: Material) -> bool {
     return HAS_DIELECTRIC && m.kind == MATERIAL_DIELECTRIC;
+}
+
+fn is_pbr(m: Material) -> bool {
+    return HAS_PBR && m.kind == MATERIAL_PBR;
 }
 
 // Mirrors, glass and very smooth metal scatter into single directions: light sampling cannot
@@ -24,6 +28,9 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> vec3<f3
     if cos_i <= 0.0 || is_delta(m) {
         return vec3<f32>(0.0);
     }
+    if is_pbr(m) {
+        return pbr_eval(pbr_lobes(m, dot(wo, n)), to_local(wo, n), to_local(wi, n));
+    }
     if is_metal(m) {
         return conductor_eval(m.albedo, m.alpha, to_local(wo, n), to_local(wi, n));
     }
@@ -34,6 +41,9 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> vec3<f3
 fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> f32 {
     if is_delta(m) {
         return 0.0;
+    }
+    if is_pbr(m) {
+        return pbr_pdf(pbr_lobes(m, dot(wo, n)), to_local(wo, n), to_local(wi, n));
     }
     if is_metal(m) {
         return ggx_reflection_pdf(to_local(wo, n), to_local(wi, n), m.alpha);
@@ -56,6 +66,9 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: 
         return dielectric_sample(m.albedo, m.ior, wo, n, front_face, rng);
     }
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
+    if is_pbr(m) {
+        return pbr_sample(pbr_lobes(m, dot(wo, n)), wo, n, rng_next(rng), u);
+    }
     if is_metal(m) {
         return conductor_sample(m.albedo, m.alpha, wo, n, u);
     }

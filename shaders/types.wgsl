@@ -79,6 +79,7 @@ const MATERIAL_DIFFUSE: u32 = 0u;
 const MATERIAL_SPECULAR: u32 = 1u;
 const MATERIAL_METAL: u32 = 2u;
 const MATERIAL_DIELECTRIC: u32 = 3u;
+const MATERIAL_PBR: u32 = 4u;
 
 struct Material {
     // Diffuse albedo, mirror reflectance, metal F0, or glass transmission tint.
@@ -93,6 +94,11 @@ struct Material {
     color_texture: u32,
     // Texture whose first channel replaces the metal's roughness (alpha = r * r), or NO_TEXTURE.
     roughness_texture: u32,
+    // PBR: the conductor's share.
+    metallic: f32,
+    // PBR: KHR_materials_specular's colour and factor for the dielectric layer.
+    specular_color: vec3<f32>,
+    specular: f32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;

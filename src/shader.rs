@@ -2,13 +2,13 @@
 
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, Material, Quad, Sphere, MATERIAL_DIELECTRIC, MATERIAL_METAL, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, Emitter, Material, Quad, Sphere, MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR,
+    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 22] = [
+pub const SHADER_PARTS: [(&str, &str); 24] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -32,6 +32,11 @@ pub const SHADER_PARTS: [(&str, &str); 22] = [
         "dielectric.wgsl",
         include_str!("../shaders/dielectric.wgsl"),
     ),
+    (
+        "ggx_energy.wgsl",
+        include_str!("../shaders/ggx_energy.wgsl"),
+    ),
+    ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
     (
@@ -216,6 +221,8 @@ pub struct KernelFeatures {
     pub triangle_emitters: bool,
     pub metal: bool,
     pub dielectric: bool,
+    /// glTF's metallic-roughness material (shaders/pbr.wgsl) and its energy tables.
+    pub pbr: bool,
     /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/aov.wgsl).
     pub aovs: bool,
     /// Textured materials: texture coordinates at hits and lookups (shaders/texture.wgsl).
@@ -234,6 +241,7 @@ impl KernelFeatures {
         triangle_emitters: true,
         metal: true,
         dielectric: true,
+        pbr: true,
         aovs: true,
         textures: true,
         environment: true,
@@ -250,6 +258,7 @@ impl KernelFeatures {
             triangle_emitters: emits(PRIMITIVE_TRIANGLE),
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
+            pbr: has_kind(MATERIAL_PBR),
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
             environment: scene.params.environment_width > 0,
@@ -265,6 +274,7 @@ impl KernelFeatures {
             && needs(self.triangle_emitters, other.triangle_emitters)
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
+            && needs(self.pbr, other.pbr)
             && needs(self.aovs, other.aovs)
             && needs(self.textures, other.textures)
             && needs(self.environment, other.environment)
@@ -275,7 +285,8 @@ impl KernelFeatures {
         format!(
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
-             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n\
+             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
+             const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
@@ -283,6 +294,7 @@ impl KernelFeatures {
             self.triangle_emitters,
             self.metal,
             self.dielectric,
+            self.pbr,
             self.aovs,
             self.textures,
             self.environment

@@ -1,5 +1,5 @@
 //! The BSDF of each material kind, dispatched to its lobes (WGSL side: `shaders/material.wgsl`):
-//! `diffuse.rs`, `conductor.rs`, `dielectric.rs`, on `microfacet.rs` and `frame.rs`.
+//! `diffuse.rs`, `conductor.rs`, `dielectric.rs`, `pbr.rs`, on `microfacet.rs` and `frame.rs`.
 
 pub use super::bsdf::BsdfSample;
 use super::conductor::{conductor_eval, conductor_sample, MIN_METAL_ALPHA};
@@ -7,8 +7,11 @@ use super::dielectric::dielectric_sample;
 use super::diffuse::{diffuse_eval, diffuse_sample};
 use super::frame::{reflect, to_local, PI};
 use super::microfacet::ggx_reflection_pdf;
+use super::pbr::{pbr_eval, pbr_lobes, pbr_pdf, pbr_sample};
 use super::rng::Rng;
-use crate::shader_types::{Material, MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_SPECULAR};
+use crate::shader_types::{
+    Material, MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR,
+};
 use glam::Vec3;
 
 /// Mirrors, glass and very smooth metal scatter into single directions.
@@ -25,6 +28,10 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
     if cos_i <= 0.0 || is_delta(m) {
         return Vec3::ZERO;
     }
+    if m.kind == MATERIAL_PBR {
+        let lobes = pbr_lobes(m, wo.dot(n));
+        return pbr_eval(&lobes, to_local(wo, n), to_local(wi, n));
+    }
     if m.kind == MATERIAL_METAL {
         return conductor_eval(
             Vec3::from(m.albedo),
@@ -40,6 +47,10 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
 pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> f32 {
     if is_delta(m) {
         return 0.0;
+    }
+    if m.kind == MATERIAL_PBR {
+        let lobes = pbr_lobes(m, wo.dot(n));
+        return pbr_pdf(&lobes, to_local(wo, n), to_local(wi, n));
     }
     if m.kind == MATERIAL_METAL {
         return ggx_reflection_pdf(to_local(wo, n), to_local(wi, n), m.alpha);
@@ -62,6 +73,10 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, n: Vec3, front_face: bool, rng: &mut 
         return dielectric_sample(Vec3::from(m.albedo), m.ior, wo, n, front_face, rng);
     }
     let u = (rng.next_f32(), rng.next_f32());
+    if m.kind == MATERIAL_PBR {
+        let lobes = pbr_lobes(m, wo.dot(n));
+        return pbr_sample(&lobes, wo, n, rng.next_f32(), u);
+    }
     if m.kind == MATERIAL_METAL {
         return conductor_sample(Vec3::from(m.albedo), m.alpha, wo, n, u);
     }

@@ -246,6 +246,13 @@ impl<'a> GpuRenderer<'a> {
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
+        // The PBR material's energy tables (src/ggx_energy.rs), a placeholder without one.
+        let ggx_energy: &[f32] = if variant.features.pbr {
+            crate::ggx_energy::ggx_energy_table()
+        } else {
+            &[]
+        };
+        let ggx_energy = storage_buffer(ctx, "GGX energy tables", ggx_energy);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -313,6 +320,7 @@ impl<'a> GpuRenderer<'a> {
                 (22, read_only, &triangle_uvs),
                 (18, read_only, &environment_texels),
                 (19, read_only, &environment_alias),
+                (24, read_only, &ggx_energy),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -7,9 +7,9 @@ use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_SPECULAR,
-    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
-    ROULETTE_OFF,
+    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR,
+    MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::Vec3;
 
@@ -176,6 +176,7 @@ impl Scene {
             .materials
             .iter()
             .map(|m| {
+                let (mut metallic, mut specular, mut specular_color) = (0.0, 0.0, Vec3::ZERO);
                 let (kind, alpha, ior) = match m.kind {
                     MaterialKind::Diffuse => (MATERIAL_DIFFUSE, 0.0, 1.0),
                     MaterialKind::Specular => (MATERIAL_SPECULAR, 0.0, 1.0),
@@ -183,6 +184,16 @@ impl Scene {
                         (MATERIAL_METAL, roughness * roughness, 1.0)
                     }
                     MaterialKind::Dielectric { ior } => (MATERIAL_DIELECTRIC, 0.0, ior),
+                    MaterialKind::Pbr {
+                        roughness,
+                        metallic: m,
+                        ior,
+                        specular: s,
+                        specular_color: c,
+                    } => {
+                        (metallic, specular, specular_color) = (m, s, c);
+                        (MATERIAL_PBR, roughness * roughness, ior)
+                    }
                 };
                 shader_types::Material {
                     albedo: m.color.into(),
@@ -192,7 +203,9 @@ impl Scene {
                     ior,
                     color_texture: m.color_texture.unwrap_or(NO_TEXTURE),
                     roughness_texture: m.roughness_texture.unwrap_or(NO_TEXTURE),
-                    _pad: 0,
+                    metallic,
+                    specular_color: specular_color.into(),
+                    specular,
                 }
             })
             .collect();

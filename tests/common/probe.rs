@@ -69,6 +69,7 @@ pub fn run_probe(
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
+    let ggx_energy = storage_buffer(ctx, "GGX energy", glint::ggx_energy::ggx_energy_table());
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -106,6 +107,7 @@ pub fn run_probe(
             (22, read_only, &triangle_uvs),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
+            (24, read_only, &ggx_energy),
         ],
     );
     let pipeline = compute_pipeline(device, entry, &layout, &module, entry);

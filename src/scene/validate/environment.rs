@@ -1,9 +1,9 @@
 //! `[environment]`: the map, its strength and rotation.
 
-use super::fields::{fail, real, FieldError};
 use super::super::environment::{self, Environment};
 use super::super::file::{EnvironmentToml, S};
 use super::super::limits::MAX_RADIANCE;
+use super::fields::{fail, real, FieldError};
 use std::path::Path;
 
 /// `[environment]`: the map read relative to `folder`, its strength and rotation in range.

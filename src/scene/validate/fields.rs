@@ -1,9 +1,9 @@
 //! The checks every part of a scene file shares: numbers, 3-vectors, lengths, radiances, and
 //! the error that ties a failure to its field and place.
 
+use super::super::check_range;
 use super::super::file::{Real, Triple, S};
 use super::super::limits::{MAX_COORDINATE, MAX_RADIANCE};
-use super::super::check_range;
 use glam::{DVec3, Vec3};
 use std::ops::Range;
 
@@ -105,7 +105,12 @@ pub(super) fn coordinates(x: &S<Triple>, field: &str) -> Result<Vec3, FieldError
 
 /// A length with a lower bound of `min` (0 or [`MIN_LENGTH`]) and the coordinate range's
 /// upper bound.
-pub(super) fn length_in_range(x: &S<Real>, field: &str, value: f32, min: f32) -> Result<f32, FieldError> {
+pub(super) fn length_in_range(
+    x: &S<Real>,
+    field: &str,
+    value: f32,
+    min: f32,
+) -> Result<f32, FieldError> {
     if !(min..=MAX_COORDINATE).contains(&value) {
         return fail(
             x.span(),
@@ -133,7 +138,11 @@ pub(super) fn non_negative(x: &S<Triple>, field: &str) -> Result<Vec3, FieldErro
 }
 
 /// A radiance (emitted or background): ≥ 0 and at most [`MAX_RADIANCE`] per channel.
-pub(super) fn radiance_in_range(span: Range<usize>, field: &str, value: DVec3) -> Result<(), FieldError> {
+pub(super) fn radiance_in_range(
+    span: Range<usize>,
+    field: &str,
+    value: DVec3,
+) -> Result<(), FieldError> {
     if value.max_element() > MAX_RADIANCE {
         return fail(
             span,

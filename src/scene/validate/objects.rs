@@ -101,9 +101,7 @@ pub(super) fn validate_objects(
             Some(s) => {
                 let v = match s.get_ref() {
                     ScaleToml::Uniform(r) => Vec3::splat(r.0 as f32),
-                    ScaleToml::PerAxis(a) => {
-                        Vec3::new(a[0].0 as f32, a[1].0 as f32, a[2].0 as f32)
-                    }
+                    ScaleToml::PerAxis(a) => Vec3::new(a[0].0 as f32, a[1].0 as f32, a[2].0 as f32),
                 };
                 if !v.is_finite() || v.min_element() <= 0.0 {
                     return fail(
