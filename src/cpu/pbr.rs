@@ -64,6 +64,14 @@ fn multiple_scattering_fresnel(f_average: Vec3, e_average: f32) -> Vec3 {
     f_average * f_average * e_average / (Vec3::ONE - f_average * (1.0 - e_average))
 }
 
+impl PbrLobes {
+    /// The probability with which [`pbr_sample`] samples the specular lobe (tests check the
+    /// sampler against it).
+    pub fn specular_probability(&self) -> f32 {
+        self.specular_probability
+    }
+}
+
 pub fn pbr_lobes(m: &Material, mu_o: f32) -> PbrLobes {
     let base = Vec3::from(m.albedo);
     let alpha = m.alpha.max(PBR_MIN_ALPHA);
