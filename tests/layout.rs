@@ -150,7 +150,10 @@ fn rust_structs_match_wgsl_layout() {
             alpha,
             ior,
             color_texture,
-            roughness_texture
+            roughness_texture,
+            metallic,
+            specular_color,
+            specular
         ]
     );
     assert_same_layout!(
@@ -179,7 +182,7 @@ fn rust_structs_match_wgsl_layout() {
         [kind, first_texel, width, height, color0, scale, color1]
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
-    assert_eq!(size_of::<Material>(), 48, "Material stays 48 bytes");
+    assert_eq!(size_of::<Material>(), 64, "Material stays 64 bytes");
     assert_same_layout!(
         &module,
         EnvironmentTexel,

@@ -73,7 +73,7 @@ fn a_white_pbr_material_reflects_everything_at_every_angle() {
 fn the_pbr_brdf_is_reciprocal() {
     let mut rng = Rng::new(1, 2, 3, 4);
     let n = Vec3::Z;
-    let mut random_direction = |rng: &mut Rng| {
+    let random_direction = |rng: &mut Rng| {
         let z: f32 = rng.next_f32().max(0.02);
         let phi = 2.0 * std::f32::consts::PI * rng.next_f32();
         let s = (1.0 - z * z).sqrt();
