@@ -1,6 +1,7 @@
-//! An OpenEXR file's header attributes, read straight from its bytes, for what the `exr`
+//! An OpenEXR file's header attributes, read straight from its bytes, for two things the `exr`
 //! crate does not do: writing them in a fixed order (it writes them from a hash map, in an
-//! order that changes from run to run).
+//! order that changes from run to run), and naming a compression it cannot read (its error
+//! then says only "unknown compression method").
 //!
 //! The header follows the 4-byte magic number and 4-byte version field. Each attribute is its
 //! name, a NUL, its type name, a NUL, its size (i32, little-endian) and its value; an empty
@@ -11,9 +12,21 @@ use std::ops::Range;
 const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 const MULTI_PART: u32 = 0x1000;
 
+/// The compressions by their header value, as OpenEXR names them.
+const COMPRESSIONS: [&str; 14] = [
+    "none", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB", "HTJ2K256",
+    "HTJ2K32", "LJ2K", "ZSTD",
+];
+
+/// The compressions the `exr` crate reads (values 0 to 9).
+pub const READABLE_COMPRESSIONS: &[&str] = &[
+    "none", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB",
+];
+
 /// One attribute, as ranges of the file's bytes.
 struct Attribute {
     name: Range<usize>,
+    value: Range<usize>,
     /// Name to value, inclusive.
     whole: Range<usize>,
 }
@@ -46,6 +59,7 @@ fn attributes(file: &[u8]) -> Result<(Vec<Attribute>, usize), String> {
             .ok_or_else(truncated)?;
         attributes.push(Attribute {
             name: at..name_end,
+            value: type_end + 5..end,
             whole: at..end,
         });
         at = end;
@@ -68,6 +82,21 @@ pub fn sort_attributes(file: &mut [u8]) -> Result<(), String> {
         .collect();
     file[8..end].copy_from_slice(&sorted);
     Ok(())
+}
+
+/// The compression the (first) header names, as OpenEXR calls it ("ZSTD"), if there is one.
+pub fn compression(file: &[u8]) -> Option<String> {
+    let (attributes, _) = attributes(file).ok()?;
+    let value = attributes
+        .iter()
+        .find(|a| &file[a.name.clone()] == b"compression")
+        .and_then(|a| file.get(a.value.clone()))?;
+    let code = *value.first()? as usize;
+    Some(
+        COMPRESSIONS
+            .get(code)
+            .map_or_else(|| format!("number {code}"), |name| name.to_string()),
+    )
 }
 
 #[cfg(test)]
@@ -101,5 +130,14 @@ mod tests {
         let mut truncated = file(&[attribute("glint.a", "string", b"xyz")]);
         truncated.truncate(20);
         assert!(sort_attributes(&mut truncated).is_err());
+    }
+
+    #[test]
+    fn the_compression_is_named() {
+        let with = |code: u8| file(&[attribute("compression", "compression", &[code])]);
+        assert_eq!(compression(&with(9)).as_deref(), Some("DWAB"));
+        assert_eq!(compression(&with(13)).as_deref(), Some("ZSTD"));
+        assert_eq!(compression(&with(200)).as_deref(), Some("number 200"));
+        assert_eq!(compression(&file(&[])), None);
     }
 }

@@ -659,13 +659,20 @@ impl SceneToml {
             }
         }
         let environment = match &self.environment {
-            Some(e) => Some(validate_environment(
-                e,
-                render.background.is_some(),
-                folder,
-            )?),
+            Some(e) => {
+                let environment = validate_environment(e, render.background.is_some(), folder)?;
+                if let Some(clamped) = environment.image.clamped {
+                    warnings.push(format!(
+                        "{}: {}",
+                        e.get_ref().file.get_ref(),
+                        clamped.warning()
+                    ));
+                }
+                Some(environment)
+            }
             None => None,
         };
+        warnings.append(&mut textures.warnings);
         let scene = Scene {
             name,
             camera: Camera {
