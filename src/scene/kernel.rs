@@ -91,7 +91,8 @@ impl Scene {
     }
 
     /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission ×
-    /// strength, the BVH). Fails (bad input) when the BVH is deeper than the traversal stack.
+    /// strength, the BVH). Fails (bad input) when there are more primitives than the BVH can
+    /// reference.
     pub fn try_kernel_scene(&self) -> Result<KernelScene, InputError> {
         let r = &self.render;
         let environment = self.environment.as_ref().map(|e| (e, e.tables()));
@@ -275,8 +276,8 @@ impl Scene {
             scene.quads.len(),
             scene.triangles.len(),
         ) {
-            // Validation bounds the primitive count far below what a reference holds; a tree
-            // deeper than the traversal stack (rare with PLOC) is refused.
+            // Validation bounds the primitive count far below what a reference holds, and the
+            // builder bounds the tree's depth by the traversal stack: this error is a backstop.
             let tree = bvh::build(&scene.spheres, &scene.quads, &scene.triangles)
                 .map_err(|e| InputError(format!("the scene cannot be rendered: {e}")))?;
             scene.bvh_nodes = tree.nodes;
