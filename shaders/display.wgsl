@@ -18,7 +18,7 @@ struct Display {
     pad: u32,
 }
 
-@group(0) @binding(0) var<uniform> display: Display;
+@group(0) @binding(0) var<storage, read> display: Display;
 // Per pixel vec4: linear radiance (xyz), row-major, row 0 at the top.
 @group(0) @binding(1) var<storage, read> mean: array<vec4<f32>>;
 

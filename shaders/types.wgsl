@@ -79,6 +79,7 @@ const MATERIAL_DIFFUSE: u32 = 0u;
 const MATERIAL_SPECULAR: u32 = 1u;
 const MATERIAL_METAL: u32 = 2u;
 const MATERIAL_DIELECTRIC: u32 = 3u;
+const MATERIAL_PBR: u32 = 4u;
 
 struct Material {
     // Diffuse albedo, mirror reflectance, metal F0, or glass transmission tint.
@@ -93,6 +94,11 @@ struct Material {
     color_texture: u32,
     // Texture whose first channel replaces the metal's roughness (alpha = r * r), or NO_TEXTURE.
     roughness_texture: u32,
+    // PBR: the conductor's share.
+    metallic: f32,
+    // PBR: KHR_materials_specular's colour and factor for the dielectric layer.
+    specular_color: vec3<f32>,
+    specular: f32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;
@@ -193,7 +199,8 @@ struct Ray {
     dir: vec3<f32>,
 }
 
-@group(0) @binding(0) var<uniform> params: Params;
+// Binding 0, params: Params, is declared by the host, in a uniform or a storage buffer
+// (src/gpu/inline_uniforms.rs says why).
 // The scene's objects (bindings 1, 2, 3 and 6) are declared by scene_storage.wgsl or
 // scene_uniform.wgsl, whichever the host chose (src/shader.rs).
 // Per pixel, over all samples so far: the mean radiance (xyz; w unused) and M2, the sum of

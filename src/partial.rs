@@ -196,14 +196,16 @@ impl Partial {
             AnyChannels::sort(channels),
         );
         let image = exr::prelude::Image::from_layer(layer);
+        let mut bytes = Vec::new();
+        image
+            .write()
+            .to_buffered(std::io::Cursor::new(&mut bytes))
+            .with_context(|| format!("cannot encode {}", path.display()))?;
+        crate::exr_header::sort_attributes(&mut bytes)
+            .map_err(|e| anyhow::anyhow!("cannot encode {}: {e}", path.display()))?;
         // Through a temporary file next to `path`, then a rename (src/atomic_write.rs): a
         // reader never sees half a file, and nothing is left on an error.
-        crate::atomic_write::write_atomically_via_path(path, |tmp| {
-            image
-                .write()
-                .to_file(tmp)
-                .with_context(|| format!("cannot encode {}", path.display()))
-        })
+        crate::atomic_write::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))
     }
 
     /// Reads a partial file. Every problem (not an EXR, truncated, a missing channel or

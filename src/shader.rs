@@ -3,19 +3,40 @@
 use crate::scene::KernelScene;
 use crate::shader_types::{
     BvhNode, Emitter, Material, Quad, Sphere, LIGHT_SUN, MATERIAL_DIELECTRIC, MATERIAL_METAL,
-    PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    MATERIAL_PBR, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 16] = [
+pub const SHADER_PARTS: [(&str, &str); 25] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
     ("surface.wgsl", include_str!("../shaders/surface.wgsl")),
+    (
+        "shading_normal.wgsl",
+        include_str!("../shaders/shading_normal.wgsl"),
+    ),
     ("triangle.wgsl", include_str!("../shaders/triangle.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
+    ("frame.wgsl", include_str!("../shaders/frame.wgsl")),
+    ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
+    (
+        "microfacet.wgsl",
+        include_str!("../shaders/microfacet.wgsl"),
+    ),
+    ("diffuse.wgsl", include_str!("../shaders/diffuse.wgsl")),
+    ("conductor.wgsl", include_str!("../shaders/conductor.wgsl")),
+    (
+        "dielectric.wgsl",
+        include_str!("../shaders/dielectric.wgsl"),
+    ),
+    (
+        "ggx_energy.wgsl",
+        include_str!("../shaders/ggx_energy.wgsl"),
+    ),
+    ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
     (
@@ -201,6 +222,8 @@ pub struct KernelFeatures {
     pub triangle_emitters: bool,
     pub metal: bool,
     pub dielectric: bool,
+    /// glTF's metallic-roughness material (shaders/pbr.wgsl) and its energy tables.
+    pub pbr: bool,
     /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/aov.wgsl).
     pub aovs: bool,
     /// Textured materials: texture coordinates at hits and lookups (shaders/texture.wgsl).
@@ -223,6 +246,7 @@ impl KernelFeatures {
         triangle_emitters: true,
         metal: true,
         dielectric: true,
+        pbr: true,
         aovs: true,
         textures: true,
         environment: true,
@@ -242,6 +266,7 @@ impl KernelFeatures {
             triangle_emitters: emits(PRIMITIVE_TRIANGLE),
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
+            pbr: has_kind(MATERIAL_PBR),
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
             environment: scene.params.environment_width > 0,
@@ -262,6 +287,7 @@ impl KernelFeatures {
             && needs(self.triangle_emitters, other.triangle_emitters)
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
+            && needs(self.pbr, other.pbr)
             && needs(self.aovs, other.aovs)
             && needs(self.textures, other.textures)
             && needs(self.environment, other.environment)
@@ -274,7 +300,8 @@ impl KernelFeatures {
         format!(
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
-             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst AOVS: bool = {};\n\
+             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
+             const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n",
             self.light_sampling,
@@ -283,6 +310,7 @@ impl KernelFeatures {
             self.triangle_emitters,
             self.metal,
             self.dielectric,
+            self.pbr,
             self.aovs,
             self.textures,
             self.environment,
@@ -321,13 +349,40 @@ pub fn render_kernel_source() -> String {
     render_kernel_source_for(KernelVariant::GENERAL)
 }
 
-/// The whole kernel as one WGSL module, in the given variant.
+/// Where the kernel reads its `Params` from (src/gpu/inline_uniforms.rs chooses per device).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamsBinding {
+    Uniform,
+    /// A read-only storage buffer, whose values drivers never compile into the kernel.
+    Storage,
+}
+
+impl ParamsBinding {
+    /// The WGSL address space of the declaration.
+    pub fn address_space(&self) -> &'static str {
+        match self {
+            ParamsBinding::Uniform => "uniform",
+            ParamsBinding::Storage => "storage, read",
+        }
+    }
+}
+
+/// The whole kernel as one WGSL module, in the given variant, with `Params` in a uniform buffer.
 pub fn render_kernel_source_for(variant: KernelVariant) -> String {
+    render_kernel_source_with(variant, ParamsBinding::Uniform)
+}
+
+/// The whole kernel as one WGSL module, in the given variant, with `Params` bound as `params`.
+pub fn render_kernel_source_with(variant: KernelVariant, params: ParamsBinding) -> String {
     let (scene_name, scene_text) = variant.binding.part();
     let mut source = String::new();
     for (i, (name, text)) in SHADER_PARTS.iter().enumerate() {
         source += &format!("// ---- {name}\n{text}\n");
         if i == 0 {
+            source += &format!(
+                "// ---- params\n@group(0) @binding(0) var<{}> params: Params;\n",
+                params.address_space()
+            );
             source += &format!("// ---- features\n{}\n", variant.features.part());
             source += &format!("// ---- {scene_name}\n{scene_text}\n");
         }

@@ -93,6 +93,8 @@ pub const MATERIAL_DIFFUSE: u32 = 0;
 pub const MATERIAL_SPECULAR: u32 = 1;
 pub const MATERIAL_METAL: u32 = 2;
 pub const MATERIAL_DIELECTRIC: u32 = 3;
+/// glTF's metallic-roughness material (`src/cpu/pbr.rs`).
+pub const MATERIAL_PBR: u32 = 4;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -109,7 +111,11 @@ pub struct Material {
     pub color_texture: u32,
     /// Texture whose first channel replaces the metal's roughness (alpha = r²), or [`NO_TEXTURE`].
     pub roughness_texture: u32,
-    pub _pad: u32,
+    /// PBR: the conductor's share.
+    pub metallic: f32,
+    /// PBR: KHR_materials_specular's colour and factor for the dielectric layer.
+    pub specular_color: [f32; 3],
+    pub specular: f32,
 }
 
 /// `Material::color_texture` and `roughness_texture` when the value is constant.

@@ -6,7 +6,7 @@ mod common;
 use common::chi2::{assert_fits, directions, directions_integrated, pearson, uniform_2d};
 use common::probe::{run_probe, ProbeParams};
 use glam::Vec3;
-use glint::cpu::material::sample_cosine_hemisphere;
+use glint::cpu::diffuse::sample_cosine_hemisphere;
 use glint::cpu::rng::Rng;
 use std::f64::consts::PI;
 
@@ -1033,4 +1033,59 @@ fn gpu_sun_disk_sampling() {
         &kernel,
     );
     check_sun_samples("gpu sun disk", &samples);
+}
+
+/// The PBR material's sampler: with probability p (from the lobes' albedos) the visible-normal
+/// GGX reflection, else a cosine lobe. Its density over the whole sphere is
+/// p · D_vis + (1 − p) · max(cos, 0)/π, with the GGX density written independently above;
+/// samples below the surface are absorbed (weight 0) but still drawn with that density.
+#[test]
+fn cpu_pbr_sampling() {
+    for (k, (name, n, wo, alpha)) in metal_cases().into_iter().enumerate() {
+        for metallic in [0.0f32, 1.0] {
+            let m = glint::shader_types::Material {
+                albedo: [0.8, 0.5, 0.3],
+                kind: glint::shader_types::MATERIAL_PBR,
+                alpha,
+                ior: 1.5,
+                metallic,
+                specular: 1.0,
+                specular_color: [1.0; 3],
+                ..Default::default()
+            };
+            let p = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n)).specular_probability() as f64;
+            let dirs: Vec<Vec3> = (0..SAMPLES)
+                .map(|i| {
+                    let mut r = cpu_draws(i, SEED + 97 + k as u32);
+                    let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
+                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n);
+                    let above = s.dir.dot(n) > 0.0;
+                    assert_eq!(
+                        s.weight == Vec3::ZERO,
+                        !above,
+                        "{name}: weight {}",
+                        s.weight
+                    );
+                    if above {
+                        assert!(
+                            (s.pdf - pdf).abs() <= 1e-4 * pdf,
+                            "{name}: pdf {} vs {pdf}",
+                            s.pdf
+                        );
+                    }
+                    s.dir
+                })
+                .collect();
+            let pdf = |d: Vec3| {
+                let d = d.as_dvec3().normalize();
+                let cos = d.dot(n.as_dvec3()).max(0.0);
+                p * reference_ggx_pdf(wo.as_dvec3(), d, n.as_dvec3(), alpha as f64)
+                    + (1.0 - p) * cos / PI
+            };
+            assert_fits(
+                &format!("cpu pbr, metallic {metallic}, {name}"),
+                &directions_integrated(&dirs, n, pdf, 20, 40, 48),
+            );
+        }
+    }
 }

@@ -1,7 +1,7 @@
 //! The random stream and the cosine-weighted hemisphere sampler of the CPU mirror.
 
 use glam::Vec3;
-use glint::cpu::material::sample_cosine_hemisphere;
+use glint::cpu::diffuse::sample_cosine_hemisphere;
 use glint::cpu::rng::{pcg_hash, Rng};
 
 #[test]
@@ -72,7 +72,7 @@ fn cosine_hemisphere_is_cosine_distributed() {
         Vec3::new(1.0, 2.0, -0.5).normalize(),
         Vec3::X,
     ] {
-        let (t, b) = glint::cpu::material::basis(n);
+        let (t, b) = glint::cpu::frame::basis(n);
         let mut counts = [0u64; 100];
         let n_samples = 1_000_000u64;
         let mut rng = Rng::new(0, 0, 0, 7);

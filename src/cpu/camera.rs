@@ -1,6 +1,6 @@
 //! Thin-lens camera (WGSL side: `shaders/camera.wgsl`); a pinhole when the lens radius is 0.
 
-use super::material::PI;
+use super::frame::PI;
 use super::Ray;
 use crate::shader_types::Params;
 use glam::{Vec2, Vec3};

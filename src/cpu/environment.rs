@@ -2,7 +2,7 @@
 //! next-event estimation (WGSL side: `shaders/environment.wgsl`). The conventions and the
 //! exact pdf are in `src/scene/environment.rs`, where the tables are built.
 
-use super::material::PI;
+use super::frame::PI;
 use super::rng::Rng;
 use super::texture::polynomial_atan2;
 use super::trace::SceneRefs;

@@ -1,6 +1,7 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
 use super::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
+use super::shading_normal::valid_shading_normal;
 use super::surface::{parametric_point, sphere_point};
 use super::texture::{sphere_uv, triangle_uv};
 use super::triangle::{
@@ -124,10 +125,26 @@ pub struct ClosestPrimitive {
     pub index: u32,
 }
 
+/// The closest-hit rule, the same for every traversal on every device so that any structure
+/// finds the same hit: the smallest t, and among equal t the lowest primitive reference,
+/// `(kind << PRIMITIVE_KIND_SHIFT) | index`, that is spheres first, then quads, then
+/// triangles, each by index. Whether a hit at `t` on `reference` comes before the best so far.
+pub fn hit_comes_first(t: f32, reference: u32, best_t: f32, best_reference: u32) -> bool {
+    t < best_t || (t == best_t && reference < best_reference)
+}
+
 pub fn closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
     if !geometry.bvh_nodes.is_empty() {
         return bvh_closest_primitive(geometry, ray);
     }
+    scan_closest_primitive(geometry, ray)
+}
+
+/// The closest primitive by testing every one: the structure without a BVH, and what every
+/// other traversal must agree with. It visits primitives in the closest-hit rule's order
+/// ([`hit_comes_first`]) and keeps only strictly nearer hits, so among equal t the first, the
+/// lowest reference, wins.
+pub fn scan_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
     let mut best = ClosestPrimitive {
         t: NO_HIT,
         primitive: PRIMITIVE_QUAD,
@@ -263,11 +280,12 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
     let front_face = outward.dot(ray.dir) < 0.0;
     let normal = if front_face { outward } else { -outward };
     let shading_normal = if shading != Vec3::ZERO {
-        if shading.dot(normal) >= 0.0 {
+        let facing = if shading.dot(normal) >= 0.0 {
             shading
         } else {
             -shading
-        }
+        };
+        valid_shading_normal(normal, -ray.dir, facing)
     } else {
         normal
     };

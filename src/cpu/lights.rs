@@ -6,8 +6,8 @@
 //! unit solid angle at the shading point and include the selection probability.
 
 use super::environment::{environment_pdf, sample_environment};
+use super::frame::{basis, PI};
 use super::intersect::first_hit_is;
-use super::material::{basis, PI};
 use super::punctual::{punctual_visible, sample_punctual};
 use super::rng::Rng;
 use super::trace::SceneRefs;

@@ -4,15 +4,24 @@
 
 pub mod accumulate;
 pub mod aov;
+pub mod bsdf;
 pub mod bvh;
 pub mod camera;
+pub mod conductor;
+pub mod dielectric;
+pub mod diffuse;
 pub mod environment;
+pub mod frame;
+pub mod ggx_energy;
 pub mod intersect;
 pub mod lights;
 pub mod material;
+pub mod microfacet;
+pub mod pbr;
 pub mod punctual;
 pub mod renderer;
 pub mod rng;
+pub mod shading_normal;
 pub mod surface;
 pub mod texture;
 pub mod trace;

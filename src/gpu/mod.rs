@@ -2,6 +2,7 @@
 
 pub mod binding;
 pub mod context;
+pub mod inline_uniforms;
 pub mod limits;
 pub mod loop_budget;
 pub mod renderer;

@@ -2,6 +2,7 @@
 
 use super::binding::{compute_bind_group, compute_pipeline};
 use super::context::GpuContext;
+use super::inline_uniforms::params_binding_for;
 use super::limits::{check_buffers, BufferBinding, BufferNeed};
 use super::loop_budget::{
     device_loop_limit, loop_iterations_per_sample, max_samples_per_dispatch, LAVAPIPE_LOOP_LIMIT,
@@ -13,8 +14,8 @@ use crate::output::Image;
 use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use crate::shader::{
-    render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding, RENDER_ENTRY_POINT,
-    WORKGROUP_SIZE,
+    render_kernel_source_with, KernelFeatures, KernelVariant, ParamsBinding, SceneBinding,
+    RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use crate::shader_types::{BvhNode, Params};
 use anyhow::{anyhow, Result};
@@ -217,7 +218,9 @@ impl<'a> GpuRenderer<'a> {
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
             contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::UNIFORM
+                | wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST,
         });
         let spheres = scene_buffer(ctx, "spheres", &scene.spheres, usage);
         let quads = scene_buffer(ctx, "quads", &scene.quads, usage);
@@ -245,6 +248,13 @@ impl<'a> GpuRenderer<'a> {
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
         let lights = storage_buffer(ctx, "lights", &scene.lights);
+        // The PBR material's energy tables (src/ggx_energy.rs), a placeholder without one.
+        let ggx_energy: &[f32] = if variant.features.pbr {
+            crate::ggx_energy::ggx_energy_table()
+        } else {
+            &[]
+        };
+        let ggx_energy = storage_buffer(ctx, "GGX energy tables", ggx_energy);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -281,11 +291,16 @@ impl<'a> GpuRenderer<'a> {
             mapped_at_creation: false,
         });
         let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+        let params_binding = params_binding_for(&ctx.adapter_info);
+        let params_type = match params_binding {
+            ParamsBinding::Uniform => wgpu::BufferBindingType::Uniform,
+            ParamsBinding::Storage => read_only,
+        };
         let (bind_group_layout, bind_group) = compute_bind_group(
             device,
             "scene",
             &[
-                (0, wgpu::BufferBindingType::Uniform, &params_buffer),
+                (0, params_type, &params_buffer),
                 (1, scene_type, &spheres),
                 (2, scene_type, &quads),
                 (3, scene_type, &materials),
@@ -308,11 +323,14 @@ impl<'a> GpuRenderer<'a> {
                 (18, read_only, &environment_texels),
                 (19, read_only, &environment_alias),
                 (24, read_only, &lights),
+                (25, read_only, &ggx_energy),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("glint render kernel"),
-            source: wgpu::ShaderSource::Wgsl(render_kernel_source_for(variant).into()),
+            source: wgpu::ShaderSource::Wgsl(
+                render_kernel_source_with(variant, params_binding).into(),
+            ),
         });
         let pipeline = compute_pipeline(
             device,

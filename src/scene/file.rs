@@ -101,6 +101,11 @@ pub(super) struct MaterialToml {
     pub(super) strength: Option<S<Real>>,
     pub(super) roughness: Option<S<RoughnessToml>>,
     pub(super) ior: Option<S<Real>>,
+    /// `type = "pbr"` (glTF's metallic-roughness material).
+    pub(super) base_color: Option<S<Triple>>,
+    pub(super) metallic: Option<S<Real>>,
+    pub(super) specular: Option<S<Real>>,
+    pub(super) specular_color: Option<S<Triple>>,
 }
 
 /// `roughness = 0.3`, or anything else (`{ texture = "…" }`), which validation reads.

@@ -8,8 +8,9 @@ use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_SPECULAR,
-    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR,
+    MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE,
     PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::Vec3;
@@ -96,7 +97,8 @@ impl Scene {
     }
 
     /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission ×
-    /// strength, the BVH). Fails (bad input) when the BVH is deeper than the traversal stack.
+    /// strength, the BVH). Fails (bad input) when there are more primitives than the BVH can
+    /// reference.
     pub fn try_kernel_scene(&self) -> Result<KernelScene, InputError> {
         if self.lights.iter().any(|l| l.sphere().is_some()) {
             return self.with_sphere_lights().lay_out();
@@ -216,6 +218,7 @@ impl Scene {
             .materials
             .iter()
             .map(|m| {
+                let (mut metallic, mut specular, mut specular_color) = (0.0, 0.0, Vec3::ZERO);
                 let (kind, alpha, ior) = match m.kind {
                     MaterialKind::Diffuse => (MATERIAL_DIFFUSE, 0.0, 1.0),
                     MaterialKind::Specular => (MATERIAL_SPECULAR, 0.0, 1.0),
@@ -223,6 +226,16 @@ impl Scene {
                         (MATERIAL_METAL, roughness * roughness, 1.0)
                     }
                     MaterialKind::Dielectric { ior } => (MATERIAL_DIELECTRIC, 0.0, ior),
+                    MaterialKind::Pbr {
+                        roughness,
+                        metallic: m,
+                        ior,
+                        specular: s,
+                        specular_color: c,
+                    } => {
+                        (metallic, specular, specular_color) = (m, s, c);
+                        (MATERIAL_PBR, roughness * roughness, ior)
+                    }
                 };
                 shader_types::Material {
                     albedo: m.color.into(),
@@ -232,7 +245,9 @@ impl Scene {
                     ior,
                     color_texture: m.color_texture.unwrap_or(NO_TEXTURE),
                     roughness_texture: m.roughness_texture.unwrap_or(NO_TEXTURE),
-                    _pad: 0,
+                    metallic,
+                    specular_color: specular_color.into(),
+                    specular,
                 }
             })
             .collect();
@@ -308,8 +323,8 @@ impl Scene {
             scene.quads.len(),
             scene.triangles.len(),
         ) {
-            // Validation bounds the primitive count far below what a reference holds; a tree
-            // deeper than the traversal stack (rare with PLOC) is refused.
+            // Validation bounds the primitive count far below what a reference holds, and the
+            // builder bounds the tree's depth by the traversal stack: this error is a backstop.
             let tree = bvh::build(&scene.spheres, &scene.quads, &scene.triangles)
                 .map_err(|e| InputError(format!("the scene cannot be rendered: {e}")))?;
             scene.bvh_nodes = tree.nodes;

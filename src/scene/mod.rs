@@ -157,6 +157,15 @@ pub enum MaterialKind {
     Dielectric {
         ior: f32,
     },
+    /// glTF's metallic-roughness material (`src/cpu/pbr.rs`): a dielectric specular layer over
+    /// a diffuse base, mixed with a conductor by `metallic`.
+    Pbr {
+        roughness: f32,
+        metallic: f32,
+        ior: f32,
+        specular: f32,
+        specular_color: Vec3,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]

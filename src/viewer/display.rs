@@ -56,7 +56,7 @@ impl DisplayPass {
             entries: &[
                 buffer_layout_entry(
                     0,
-                    wgpu::BufferBindingType::Uniform,
+                    wgpu::BufferBindingType::Storage { read_only: true },
                     wgpu::ShaderStages::FRAGMENT,
                 ),
                 buffer_layout_entry(
@@ -99,7 +99,7 @@ impl DisplayPass {
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("display uniform"),
             size: size_of::<DisplayUniform>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         DisplayPass {

@@ -238,3 +238,31 @@ pub fn assert_refused(run: &std::process::Output, out: &Path, needles: &[&str]) 
     }
     assert!(!out.exists(), "{} was written", out.display());
 }
+
+/// Writes a `width`×`height` EXR map with texels `texel(x, y)` (top row first) into `dir`.
+pub fn write_map(
+    dir: &std::path::Path,
+    name: &str,
+    width: u32,
+    height: u32,
+    texel: impl Fn(u32, u32) -> [f32; 3],
+) -> std::path::PathBuf {
+    let path = dir.join(name);
+    image::Rgb32FImage::from_fn(width, height, |x, y| image::Rgb(texel(x, y)))
+        .save(&path)
+        .unwrap();
+    path
+}
+
+/// `scene` with light sampling `on` and `seed`, ready for a renderer.
+pub fn with_light_sampling(scene: &Scene, on: bool, seed: u32) -> KernelScene {
+    scene
+        .clone()
+        .with_overrides(&glint::scene::RenderOverrides {
+            light_sampling: Some(on),
+            seed: Some(seed),
+            ..Default::default()
+        })
+        .unwrap()
+        .kernel_scene()
+}

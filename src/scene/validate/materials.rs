@@ -61,6 +61,31 @@ pub(super) fn validate_materials(
             };
             real(x, &field(name))
         };
+        // A number in [0, 1], or `default` when absent.
+        let unit = |x: &Option<S<Real>>, name: &str, default: f32| -> Result<f32, FieldError> {
+            let Some(x) = x else {
+                return Ok(default);
+            };
+            let v = real(x, &field(name))?;
+            if !(0.0..=1.0).contains(&v) {
+                return fail(x.span(), field(name), format!("must be in [0, 1], got {v}"));
+            }
+            Ok(v)
+        };
+        let ior_in_range = |x: &S<Real>| -> Result<f32, FieldError> {
+            let ior = real(x, &field("ior"))?;
+            if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+                return fail(
+                    x.span(),
+                    field("ior"),
+                    format!(
+                        "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
+                         numeric range glint supports), got {ior}"
+                    ),
+                );
+            }
+            Ok(ior)
+        };
         let kind = match m.kind.get_ref().as_str() {
             "diffuse" => MaterialKind::Diffuse,
             "specular" => MaterialKind::Specular,
@@ -102,27 +127,73 @@ pub(super) fn validate_materials(
                 }
                 MaterialKind::Dielectric { ior }
             }
+            "pbr" => {
+                let roughness = match m.roughness.as_ref().map(|r| (r.span(), r.get_ref())) {
+                    Some((span, RoughnessToml::Value(v))) => {
+                        let v = real(&S::new(span.clone(), *v), &field("roughness"))?;
+                        if !(0.0..=1.0).contains(&v) {
+                            return fail(
+                                span,
+                                field("roughness"),
+                                format!("must be in [0, 1], got {v}"),
+                            );
+                        }
+                        v
+                    }
+                    // A texture (read below); the constant is unused.
+                    Some((_, RoughnessToml::Other(_))) => 1.0,
+                    None => 0.5,
+                };
+                let specular_color = match &m.specular_color {
+                    Some(c) => non_negative(c, &field("specular_color"))?,
+                    None => Vec3::ONE,
+                };
+                MaterialKind::Pbr {
+                    roughness,
+                    metallic: unit(&m.metallic, "metallic", 0.0)?,
+                    ior: m.ior.as_ref().map_or(Ok(1.5), ior_in_range)?,
+                    specular: unit(&m.specular, "specular", 1.0)?,
+                    specular_color,
+                }
+            }
             other => {
                 return fail(
                     m.kind.span(),
                     field("type"),
                     format!(
-                        "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\""
+                        "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\", \"pbr\""
                     ),
                 )
             }
         };
+        let pbr = matches!(kind, MaterialKind::Pbr { .. });
         // A field that does not apply is most likely a mistake: say so.
         for (span, name, applies) in [
             (
                 m.roughness.as_ref().map(|r| r.span()),
                 "roughness",
-                matches!(kind, MaterialKind::Metal { .. }),
+                matches!(kind, MaterialKind::Metal { .. } | MaterialKind::Pbr { .. }),
             ),
             (
                 m.ior.as_ref().map(|r| r.span()),
                 "ior",
-                matches!(kind, MaterialKind::Dielectric { .. }),
+                matches!(
+                    kind,
+                    MaterialKind::Dielectric { .. } | MaterialKind::Pbr { .. }
+                ),
+            ),
+            (
+                m.color.as_ref().map(|r| r.span()),
+                "color",
+                !matches!(kind, MaterialKind::Pbr { .. }),
+            ),
+            (m.base_color.as_ref().map(|r| r.span()), "base_color", pbr),
+            (m.metallic.as_ref().map(|r| r.span()), "metallic", pbr),
+            (m.specular.as_ref().map(|r| r.span()), "specular", pbr),
+            (
+                m.specular_color.as_ref().map(|r| r.span()),
+                "specular_color",
+                pbr,
             ),
         ] {
             if let (Some(span), false) = (span, applies) {
@@ -146,25 +217,31 @@ pub(super) fn validate_materials(
             },
             None => None,
         };
-        let color_texture = match &m.color {
+        // A pbr material's colour is its base_color.
+        let (color_field, color_name) = if pbr {
+            (&m.base_color, "base_color")
+        } else {
+            (&m.color, "color")
+        };
+        let color_texture = match color_field {
             Some(c) if c.get_ref().is_table() => Some(texture(
                 c,
-                &field("color"),
+                &field(color_name),
                 folder,
                 TextureUse::Color,
                 &mut textures,
             )?),
             _ => None,
         };
-        let color = match (&m.color, kind) {
+        let color = match (color_field, kind) {
             // Textured: the constant is unused.
             (Some(_), _) if color_texture.is_some() => Vec3::ONE,
             (Some(c), _) => {
-                let color = non_negative(c, &field("color"))?;
+                let color = non_negative(c, &field(color_name))?;
                 if color.max_element() > 1.0 {
                     return fail(
                         c.span(),
-                        field("color"),
+                        field(color_name),
                         format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
                     );
                 }
@@ -175,8 +252,8 @@ pub(super) fn validate_materials(
             (None, _) => {
                 return fail(
                     m.kind.span(),
-                    field("color"),
-                    "missing: this material needs a color",
+                    field(color_name),
+                    format!("missing: this material needs a {color_name}"),
                 );
             }
         };

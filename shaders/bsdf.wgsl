@@ -1,0 +1,10 @@
+// What sampling a BSDF returns (mirror: src/cpu/bsdf.rs).
+
+struct BsdfSample {
+    dir: vec3<f32>,
+    // f * cos / pdf, or the reflectance of a delta lobe; zero when the path is absorbed.
+    weight: vec3<f32>,
+    // Solid-angle pdf of dir; 0 for delta lobes.
+    pdf: f32,
+    is_delta: bool,
+}

@@ -1,0 +1,126 @@
+// glTF 2.0's metallic-roughness material, energy-compensated (mirror: src/cpu/pbr.rs, which
+// says how): a GGX specular lobe with Schlick's Fresnel mixed between the dielectric layer's
+// and the metal's, Kulla and Conty's multiple-scattering lobe, and the diffuse base under the
+// dielectric layer by reciprocal albedo scaling.
+
+// The smallest GGX alpha of the material (roughness 0.032).
+const PBR_MIN_ALPHA: f32 = 1e-3;
+// Bounds of the probability of sampling the specular lobe, so neither strategy starves.
+const MIN_LOBE_PROBABILITY: f32 = 0.1;
+
+struct PbrLobes {
+    base: vec3<f32>,
+    metallic: f32,
+    alpha: f32,
+    dielectric_f0: vec3<f32>,
+    dielectric_f90: f32,
+    e_o: f32,
+    e_average: f32,
+    ms_dielectric: vec3<f32>,
+    ms_metal: vec3<f32>,
+    layer_o: vec3<f32>,
+    layer_average: vec3<f32>,
+    specular_probability: f32,
+}
+
+fn channel_average(v: vec3<f32>) -> f32 {
+    return (v.x + v.y + v.z) * (1.0 / 3.0);
+}
+
+// Kulla and Conty's F_ms for a lobe whose average Fresnel is f_average.
+fn multiple_scattering_fresnel(f_average: vec3<f32>, e_average: f32) -> vec3<f32> {
+    return f_average * f_average * e_average / (vec3<f32>(1.0) - f_average * (1.0 - e_average));
+}
+
+fn pbr_lobes(m: Material, mu_o: f32) -> PbrLobes {
+    var l: PbrLobes;
+    l.base = m.albedo;
+    l.alpha = max(m.alpha, PBR_MIN_ALPHA);
+    let r = (m.ior - 1.0) / (m.ior + 1.0);
+    l.dielectric_f0 = min(r * r * m.specular_color, vec3<f32>(1.0)) * m.specular;
+    l.dielectric_f90 = m.specular;
+    let ab_o = ggx_albedo(mu_o, l.alpha);
+    let ab_average = ggx_albedo_average(l.alpha);
+    l.e_o = ab_o.x + ab_o.y;
+    l.e_average = ab_average.x + ab_average.y;
+    l.ms_dielectric = multiple_scattering_fresnel(
+        l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * (1.0 / 21.0),
+        l.e_average
+    );
+    l.ms_metal = multiple_scattering_fresnel(l.base + (vec3<f32>(1.0) - l.base) * (1.0 / 21.0), l.e_average);
+    l.layer_o = l.dielectric_f0 * ab_o.x + vec3<f32>(l.dielectric_f90 * ab_o.y) + l.ms_dielectric * (1.0 - l.e_o);
+    l.layer_average = l.dielectric_f0 * ab_average.x
+        + vec3<f32>(l.dielectric_f90 * ab_average.y)
+        + l.ms_dielectric * (1.0 - l.e_average);
+    l.metallic = m.metallic;
+    let specular = (1.0 - l.metallic) * (l.dielectric_f0 * ab_o.x + vec3<f32>(l.dielectric_f90 * ab_o.y))
+        + l.metallic * (l.base * ab_o.x + vec3<f32>(ab_o.y));
+    let ms = ((1.0 - l.metallic) * l.ms_dielectric + l.metallic * l.ms_metal) * (1.0 - l.e_o);
+    let diffuse = (1.0 - l.metallic) * l.base * (vec3<f32>(1.0) - l.layer_o);
+    let specular_weight = channel_average(specular);
+    let other_weight = channel_average(ms + diffuse);
+    let total = specular_weight + other_weight;
+    l.specular_probability = 0.5;
+    if total > 0.0 {
+        l.specular_probability = clamp(specular_weight / total, MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY);
+    }
+    return l;
+}
+
+// f * cos(theta_i); wo and wi in the local frame.
+fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let h = normalize(wo + wi);
+    let c = clamp(1.0 - dot(wo, h), 0.0, 1.0);
+    let s5 = c * c * c * c * c;
+    let f_dielectric = l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * s5;
+    let f_metal = l.base + (vec3<f32>(1.0) - l.base) * s5;
+    let fresnel = (1.0 - l.metallic) * f_dielectric + l.metallic * f_metal;
+    let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
+    let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
+    let ab_i = ggx_albedo(wi.z, l.alpha);
+    let e_i = ab_i.x + ab_i.y;
+    var out = specular;
+    if l.e_average < 1.0 {
+        let ms = (1.0 - l.metallic) * l.ms_dielectric + l.metallic * l.ms_metal;
+        out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
+    }
+    let layer_i = l.dielectric_f0 * ab_i.x + vec3<f32>(l.dielectric_f90 * ab_i.y) + l.ms_dielectric * (1.0 - e_i);
+    let transmitted = (vec3<f32>(1.0) - l.layer_o) * (vec3<f32>(1.0) - layer_i);
+    let room = vec3<f32>(1.0) - l.layer_average;
+    let base_weight = select(vec3<f32>(0.0), transmitted / room, room > vec3<f32>(0.0));
+    return out + (1.0 - l.metallic) * l.base * base_weight * (wi.z / PI);
+}
+
+// The mixture pdf of pbr_sample; wo and wi in the local frame.
+fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let p = l.specular_probability;
+    return p * ggx_reflection_pdf(wo, wi, l.alpha) + (1.0 - p) * (wi.z / PI);
+}
+
+// `choice` picks the lobe, u the direction; n faces wo.
+fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32>) -> BsdfSample {
+    var out: BsdfSample;
+    out.is_delta = false;
+    let wo_l = to_local(wo, n);
+    var wi_l: vec3<f32>;
+    if choice < l.specular_probability {
+        let h = sample_ggx_visible_normal(wo_l, l.alpha, u);
+        wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
+        out.dir = normalize(from_local(wi_l, n));
+    } else {
+        out.dir = sample_cosine_hemisphere(n, u);
+        wi_l = to_local(out.dir, n);
+    }
+    out.pdf = pbr_pdf(l, wo_l, wi_l);
+    out.weight = vec3<f32>(0.0);
+    if out.pdf > 0.0 {
+        out.weight = pbr_eval(l, wo_l, wi_l) / out.pdf;
+    }
+    return out;
+}

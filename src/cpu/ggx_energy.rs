@@ -1,0 +1,44 @@
+//! Lookups in the GGX albedo tables of `crate::ggx_energy` (WGSL side:
+//! `shaders/ggx_energy.wgsl`, which reads the same numbers from binding 24): bilinear in
+//! μ = cos θ and α, the same f32 operations on both sides.
+
+use crate::ggx_energy::{
+    ggx_energy_table, GGX_ENERGY_SIZE, OFFSET_A, OFFSET_A_AVERAGE, OFFSET_B, OFFSET_B_AVERAGE,
+};
+
+/// The α row below `alpha` and the weight of the one above.
+fn alpha_row(alpha: f32) -> (usize, f32) {
+    let y = (alpha * (GGX_ENERGY_SIZE - 1) as f32).clamp(0.0, (GGX_ENERGY_SIZE - 1) as f32);
+    let j = (y as usize).min(GGX_ENERGY_SIZE - 2);
+    (j, y - j as f32)
+}
+
+/// (A, B) at cos θ = `mu` and `alpha`: the split-sum albedo f0·A + f90·B of a GGX lobe with
+/// Schlick's Fresnel.
+pub fn ggx_albedo(mu: f32, alpha: f32) -> (f32, f32) {
+    let table = ggx_energy_table();
+    let n = GGX_ENERGY_SIZE;
+    let x = (mu * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+    let i = (x as usize).min(n - 2);
+    let t = x - i as f32;
+    let (j, s) = alpha_row(alpha);
+    let at = |offset: usize| {
+        let row0 = offset + j * n + i;
+        let row1 = row0 + n;
+        let low = table[row0] + t * (table[row0 + 1] - table[row0]);
+        let high = table[row1] + t * (table[row1 + 1] - table[row1]);
+        low + s * (high - low)
+    };
+    (at(OFFSET_A), at(OFFSET_B))
+}
+
+/// The hemispherical averages (2∫A μ dμ, 2∫B μ dμ) at `alpha`.
+pub fn ggx_albedo_average(alpha: f32) -> (f32, f32) {
+    let table = ggx_energy_table();
+    let (j, s) = alpha_row(alpha);
+    let at = |offset: usize| {
+        let low = table[offset + j];
+        low + s * (table[offset + j + 1] - low)
+    };
+    (at(OFFSET_A_AVERAGE), at(OFFSET_B_AVERAGE))
+}

@@ -1,0 +1,201 @@
+//! glTF 2.0's metallic-roughness material (its specification's Appendix B, with
+//! KHR_materials_ior and KHR_materials_specular), energy-compensated (WGSL side:
+//! `shaders/pbr.wgsl`).
+//!
+//! - A GGX specular lobe, α = roughness², with Schlick's Fresnel: for the dielectric part
+//!   f0 = min(((ior − 1)/(ior + 1))² · specular_color, 1) · specular and f90 = specular, for the
+//!   metal part f0 = base colour and f90 = 1. As both parts share the microfacet distribution,
+//!   `mix(dielectric, metal, metallic)` of the specular lobes is one lobe with the mixed Fresnel.
+//! - Multiple scattering between microfacets (Kulla and Conty 2017): a lobe
+//!   F_ms · (1 − E(μo))(1 − E(μi)) / (π (1 − E_avg)), E the albedo of the lobe with F = 1 and
+//!   F_ms = F_avg² E_avg / (1 − F_avg (1 − E_avg)), F_avg Schlick's hemispherical average
+//!   f0 + (f90 − f0)/21. A white conductor then reflects everything at every roughness.
+//! - The diffuse base under the dielectric layer, by albedo scaling made reciprocal (Kulla and
+//!   Conty's layering): (1 − metallic) · base/π · (1 − Es(μo))(1 − Es(μi)) / (1 − Es_avg), Es the
+//!   dielectric layer's whole albedo (single and multiple scattering). White over white
+//!   reflects everything too; where the layer reflects more, the base gets less.
+//!
+//! The tables E, Es are looked up in `ggx_energy.rs`. Sampling picks the specular lobe (visible
+//! normals) or a cosine lobe (for the diffuse and multiple-scattering lobes) with probabilities
+//! from their albedos at μo, and weights by the mixture pdf, which MIS uses too.
+
+use super::bsdf::BsdfSample;
+use super::diffuse::sample_cosine_hemisphere;
+use super::frame::{from_local, to_local, PI};
+use super::ggx_energy::{ggx_albedo, ggx_albedo_average};
+use super::microfacet::{ggx_d, ggx_lambda, ggx_reflection_pdf, sample_ggx_visible_normal};
+use crate::shader_types::Material;
+use glam::Vec3;
+
+/// The smallest GGX α of the material (roughness 0.032): below it the specular lobe would be
+/// a delta over a diffuse base, which light sampling could not mix with.
+pub const PBR_MIN_ALPHA: f32 = 1e-3;
+
+/// Bounds of the probability of sampling the specular lobe, so neither strategy starves.
+const MIN_LOBE_PROBABILITY: f32 = 0.1;
+
+/// What the lobes need at one shading point, from the material and μo.
+#[derive(Clone, Copy, Debug)]
+pub struct PbrLobes {
+    base: Vec3,
+    metallic: f32,
+    alpha: f32,
+    dielectric_f0: Vec3,
+    dielectric_f90: f32,
+    /// E(μo) and E_avg, with F = 1.
+    e_o: f32,
+    e_average: f32,
+    /// F_ms of the dielectric and the metal part.
+    ms_dielectric: Vec3,
+    ms_metal: Vec3,
+    /// The dielectric layer's whole albedo at μo, and its average.
+    layer_o: Vec3,
+    layer_average: Vec3,
+    /// Probability of sampling the specular lobe.
+    specular_probability: f32,
+}
+
+fn average(v: Vec3) -> f32 {
+    (v.x + v.y + v.z) * (1.0 / 3.0)
+}
+
+/// Kulla and Conty's F_ms for a lobe whose average Fresnel is `f_average`.
+fn multiple_scattering_fresnel(f_average: Vec3, e_average: f32) -> Vec3 {
+    f_average * f_average * e_average / (Vec3::ONE - f_average * (1.0 - e_average))
+}
+
+impl PbrLobes {
+    /// The probability with which [`pbr_sample`] samples the specular lobe (tests check the
+    /// sampler against it).
+    pub fn specular_probability(&self) -> f32 {
+        self.specular_probability
+    }
+}
+
+pub fn pbr_lobes(m: &Material, mu_o: f32) -> PbrLobes {
+    let base = Vec3::from(m.albedo);
+    let alpha = m.alpha.max(PBR_MIN_ALPHA);
+    let r = (m.ior - 1.0) / (m.ior + 1.0);
+    let dielectric_f0 = (r * r * Vec3::from(m.specular_color)).min(Vec3::ONE) * m.specular;
+    let dielectric_f90 = m.specular;
+    let (a_o, b_o) = ggx_albedo(mu_o, alpha);
+    let (a_average, b_average) = ggx_albedo_average(alpha);
+    let e_o = a_o + b_o;
+    let e_average = a_average + b_average;
+    let ms_dielectric = multiple_scattering_fresnel(
+        dielectric_f0 + (dielectric_f90 - dielectric_f0) * (1.0 / 21.0),
+        e_average,
+    );
+    let ms_metal = multiple_scattering_fresnel(base + (Vec3::ONE - base) * (1.0 / 21.0), e_average);
+    let layer_o =
+        dielectric_f0 * a_o + Vec3::splat(dielectric_f90 * b_o) + ms_dielectric * (1.0 - e_o);
+    let layer_average = dielectric_f0 * a_average
+        + Vec3::splat(dielectric_f90 * b_average)
+        + ms_dielectric * (1.0 - e_average);
+    let metallic = m.metallic;
+    let specular = (1.0 - metallic) * (dielectric_f0 * a_o + Vec3::splat(dielectric_f90 * b_o))
+        + metallic * (base * a_o + Vec3::splat(b_o));
+    let ms = ((1.0 - metallic) * ms_dielectric + metallic * ms_metal) * (1.0 - e_o);
+    let diffuse = (1.0 - metallic) * base * (Vec3::ONE - layer_o);
+    let specular_weight = average(specular);
+    let other_weight = average(ms + diffuse);
+    let total = specular_weight + other_weight;
+    let specular_probability = if total > 0.0 {
+        (specular_weight / total).clamp(MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY)
+    } else {
+        0.5
+    };
+    PbrLobes {
+        base,
+        metallic,
+        alpha,
+        dielectric_f0,
+        dielectric_f90,
+        e_o,
+        e_average,
+        ms_dielectric,
+        ms_metal,
+        layer_o,
+        layer_average,
+        specular_probability,
+    }
+}
+
+/// f · cos θi; wo and wi in the local frame.
+pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let l = lobes;
+    let h = (wo + wi).normalize();
+    let c = (1.0 - wo.dot(h)).clamp(0.0, 1.0);
+    let s5 = c * c * c * c * c;
+    let f_dielectric = l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * s5;
+    let f_metal = l.base + (Vec3::ONE - l.base) * s5;
+    let fresnel = (1.0 - l.metallic) * f_dielectric + l.metallic * f_metal;
+    let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
+    let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
+    let (a_i, b_i) = ggx_albedo(wi.z, l.alpha);
+    let e_i = a_i + b_i;
+    let mut out = specular;
+    if l.e_average < 1.0 {
+        let ms = (1.0 - l.metallic) * l.ms_dielectric + l.metallic * l.ms_metal;
+        out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
+    }
+    let layer_i =
+        l.dielectric_f0 * a_i + Vec3::splat(l.dielectric_f90 * b_i) + l.ms_dielectric * (1.0 - e_i);
+    let transmitted = (Vec3::ONE - l.layer_o) * (Vec3::ONE - layer_i);
+    let room = Vec3::ONE - l.layer_average;
+    let base_weight = Vec3::new(
+        if room.x > 0.0 {
+            transmitted.x / room.x
+        } else {
+            0.0
+        },
+        if room.y > 0.0 {
+            transmitted.y / room.y
+        } else {
+            0.0
+        },
+        if room.z > 0.0 {
+            transmitted.z / room.z
+        } else {
+            0.0
+        },
+    );
+    out + (1.0 - l.metallic) * l.base * base_weight * (wi.z / PI)
+}
+
+/// The mixture pdf of [`pbr_sample`]; wo and wi in the local frame.
+pub fn pbr_pdf(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> f32 {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let p = lobes.specular_probability;
+    p * ggx_reflection_pdf(wo, wi, lobes.alpha) + (1.0 - p) * (wi.z / PI)
+}
+
+/// `choice` picks the lobe, `u` the direction; `n` faces wo.
+pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32)) -> BsdfSample {
+    let wo_l = to_local(wo, n);
+    let (dir, wi_l) = if choice < lobes.specular_probability {
+        let h = sample_ggx_visible_normal(wo_l, lobes.alpha, u);
+        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
+        (from_local(wi_l, n).normalize(), wi_l)
+    } else {
+        let dir = sample_cosine_hemisphere(n, u);
+        (dir, to_local(dir, n))
+    };
+    let pdf = pbr_pdf(lobes, wo_l, wi_l);
+    let weight = if pdf > 0.0 {
+        pbr_eval(lobes, wo_l, wi_l) / pdf
+    } else {
+        Vec3::ZERO
+    };
+    BsdfSample {
+        dir,
+        weight,
+        pdf,
+        is_delta: false,
+    }
+}

@@ -1,0 +1,323 @@
+//! Triangle meshes from OBJ (`tobj`), glTF (`gltf`) and PLY (`ply-rs-bw`) files: read, checked,
+//! transformed into the scene, and their own materials mapped to glint's (README.md has the
+//! table). Everything is checked here, before rendering: unreadable or malformed files, vertices
+//! that are not finite, indices out of range, meshes left with no triangles.
+//!
+//! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`); this file holds what they share: the
+//! parts a file yields, the material checks, and turning parts into scene triangles.
+
+mod gltf;
+mod obj;
+mod ply;
+
+use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
+use super::texture::{TextureSet, TextureUse};
+use super::{Material, Triangle};
+use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
+/// fit any GPU's storage binding anyway.
+pub const MAX_TRIANGLES: usize = 1 << 28;
+
+/// Where a mesh goes in the scene: scale, then rotate about x, y, z (degrees), then translate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshTransform {
+    pub scale: Vec3,
+    pub rotate_degrees: Vec3,
+    pub translate: Vec3,
+}
+
+impl MeshTransform {
+    pub fn matrix(&self) -> Mat4 {
+        let r = self.rotate_degrees * (std::f32::consts::PI / 180.0);
+        Mat4::from_translation(self.translate)
+            * Mat4::from_rotation_z(r.z)
+            * Mat4::from_rotation_y(r.y)
+            * Mat4::from_rotation_x(r.x)
+            * Mat4::from_scale(self.scale)
+    }
+}
+
+/// Triangles with one material, in the file's own coordinates: positions, optional vertex
+/// normals (as many as positions), and triangles as indices into them.
+pub(super) struct Geometry {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    /// Texture coordinates (v up), as many as positions, or none.
+    uvs: Vec<Vec2>,
+    indices: Vec<[u32; 3]>,
+}
+
+/// A part of a mesh file: its geometry, placed in the file's space. A glTF mesh used by several
+/// nodes is one geometry shared by several parts, read once.
+pub(super) struct MeshPart {
+    geometry: Rc<Geometry>,
+    /// The file's own placement (a glTF node's world transform), before the scene's.
+    transform: Mat4,
+    /// Index into the file's materials, if the file gives one.
+    material: Option<usize>,
+    /// Where the part came from, for messages (an OBJ object, a glTF node and mesh).
+    name: String,
+}
+
+impl MeshPart {
+    /// A part the file places as it is (OBJ, PLY).
+    fn unplaced(geometry: Geometry, material: Option<usize>, name: String) -> Self {
+        MeshPart {
+            geometry: Rc::new(geometry),
+            transform: Mat4::IDENTITY,
+            material,
+            name,
+        }
+    }
+}
+
+/// What a mesh file holds.
+pub(super) struct MeshFile {
+    parts: Vec<MeshPart>,
+    materials: Vec<Material>,
+    /// Per material: its colour texture's file (OBJ `map_Kd`, glTF `baseColorTexture` by URI).
+    color_textures: Vec<Option<PathBuf>>,
+    /// Whether any material refers to a texture glint does not use (normal maps, ...).
+    has_other_textures: bool,
+    /// Anything else worth a warning line, each a sentence without the file's name.
+    warnings: Vec<String>,
+}
+
+/// The triangles of one `[[meshes]]` entry, ready for the scene.
+pub(super) struct LoadedMesh {
+    pub triangles: Vec<Triangle>,
+    /// One line each, for stderr.
+    pub warnings: Vec<String>,
+}
+
+/// Reads, checks, transforms and materials one mesh file. `scene_materials` receives the file's
+/// own materials when `material` is `None`, named `<file name>/<material name>`.
+pub(super) fn load(
+    path: &Path,
+    shown: &str,
+    transform: &MeshTransform,
+    material: Option<u32>,
+    smooth: bool,
+    scene_materials: &mut Vec<Material>,
+    textures: &mut TextureSet,
+) -> Result<LoadedMesh, String> {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    if !matches!(extension.as_str(), "obj" | "gltf" | "glb" | "ply") {
+        return Err(format!(
+            "{shown}: unknown mesh format {:?}; known: .obj, .gltf, .glb, .ply",
+            if extension.is_empty() {
+                "(no extension)".to_string()
+            } else {
+                format!(".{extension}")
+            }
+        ));
+    }
+    if !path.is_file() {
+        return Err(format!("{shown}: cannot read the mesh file: no such file"));
+    }
+    let file = match extension.as_str() {
+        "obj" => obj::read_obj(path),
+        "ply" => ply::read_ply(path),
+        _ => self::gltf::read_gltf(path),
+    }
+    .map_err(|e| format!("{shown}: {e}"))?;
+    let mut warnings: Vec<String> = file
+        .warnings
+        .iter()
+        .map(|w| format!("{shown}: {w}"))
+        .collect();
+    if file.has_other_textures {
+        warnings.push(format!(
+            "{shown}: texture maps other than the base colour (normal, roughness, emission, ...) are ignored"
+        ));
+    }
+    // The file's materials become scene materials, but only when they are used.
+    let mut material_for_file: Vec<Option<u32>> = vec![None; file.materials.len()];
+    let stem = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let scene_matrix = transform.matrix();
+    let mut triangles = Vec::new();
+    let mut degenerate = 0usize;
+    let mut checked = std::collections::HashSet::new();
+    for part in &file.parts {
+        let matrix = scene_matrix * part.transform;
+        // Normals go through the inverse transpose of the linear part.
+        let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
+        let geometry = &*part.geometry;
+        // A geometry placed by many glTF nodes is checked once.
+        let first_use = checked.insert(Rc::as_ptr(&part.geometry));
+        for (i, p) in geometry.positions.iter().enumerate().filter(|_| first_use) {
+            if !p.is_finite() {
+                return Err(format!(
+                    "{shown}: {}vertex {i} is not finite: {p}",
+                    part_prefix(&part.name)
+                ));
+            }
+        }
+        let use_normals = smooth && !geometry.normals.is_empty();
+        if use_normals && first_use {
+            if let Some(i) = geometry.normals.iter().position(|n| !n.is_finite()) {
+                return Err(format!(
+                    "{shown}: {}vertex normal {i} is not finite: {}",
+                    part_prefix(&part.name),
+                    geometry.normals[i]
+                ));
+            }
+        }
+        let material = match material {
+            Some(m) => m,
+            None => {
+                let Some(index) = part.material else {
+                    return Err(format!(
+                        "{shown}: {}the file gives no material for these triangles; set `material` in [[meshes]]",
+                        part_prefix(&part.name)
+                    ));
+                };
+                match material_for_file[index] {
+                    Some(m) => m,
+                    None => {
+                        let mut m = file.materials[index].clone();
+                        if let Some(texture) = &file.color_textures[index] {
+                            let index =
+                                textures.image(texture, TextureUse::Color).map_err(|e| {
+                                    format!(
+                                        "material {:?}: texture {}: {e}",
+                                        m.name,
+                                        texture.display()
+                                    )
+                                })?;
+                            m.color_texture = Some(index);
+                        }
+                        m.name = format!("{stem}/{}", m.name);
+                        let id = scene_materials.len() as u32;
+                        scene_materials.push(m);
+                        material_for_file[index] = Some(id);
+                        id
+                    }
+                }
+            }
+        };
+        let count = geometry.positions.len();
+        for (f, idx) in geometry.indices.iter().enumerate() {
+            if let Some(&bad) = idx.iter().find(|&&i| i as usize >= count) {
+                return Err(format!(
+                    "{shown}: {}face {f} refers to vertex {bad}, but there are only {count} vertices",
+                    part_prefix(&part.name)
+                ));
+            }
+            let v = idx.map(|i| matrix.transform_point3(geometry.positions[i as usize]));
+            let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+            let area2 = cross.length();
+            if area2.is_nan() || area2 <= 0.0 || !area2.is_finite() {
+                if !v.iter().all(|p| p.is_finite()) {
+                    return Err(format!(
+                        "{shown}: {}face {f} is not finite after the transform",
+                        part_prefix(&part.name)
+                    ));
+                }
+                degenerate += 1;
+                continue;
+            }
+            let normals = use_normals
+                .then(|| {
+                    idx.map(|i| (normal_matrix * geometry.normals[i as usize]).normalize_or_zero())
+                })
+                // A zero vertex normal cannot shade: the triangle is shaded flat.
+                .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
+            let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+            triangles.push(Triangle {
+                vertices: v,
+                normals,
+                material,
+                uvs,
+            });
+            if triangles.len() > MAX_TRIANGLES {
+                return Err(format!(
+                    "{shown}: more than {MAX_TRIANGLES} triangles; glint holds at most that many"
+                ));
+            }
+        }
+    }
+    if degenerate > 0 {
+        warnings.push(format!(
+            "{shown}: skipped {degenerate} degenerate (zero-area) triangle{}",
+            if degenerate == 1 { "" } else { "s" }
+        ));
+    }
+    if triangles.is_empty() {
+        return Err(format!(
+            "{shown}: the mesh has no triangles{}",
+            if degenerate > 0 {
+                format!(" (all {degenerate} are degenerate)")
+            } else {
+                String::new()
+            }
+        ));
+    }
+    Ok(LoadedMesh {
+        triangles,
+        warnings,
+    })
+}
+
+/// A reader's message on one line: runs of whitespace (newlines, tabs) become one space.
+fn one_line(message: &str) -> String {
+    message.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn part_prefix(name: &str) -> String {
+    if name.is_empty() {
+        String::new()
+    } else {
+        format!("{name}: ")
+    }
+}
+
+fn check_reflectance(name: &str, what: &str, c: Vec3) -> Result<Vec3, String> {
+    if !c.is_finite() || c.min_element() < 0.0 || c.max_element() > 1.0 {
+        return Err(format!(
+            "material {name:?}: {what} must be in [0, 1], got {c}"
+        ));
+    }
+    Ok(c)
+}
+
+/// An emitted radiance: ≥ 0 and within glint's numeric range, as in scene files.
+fn check_emission(name: &str, what: &str, e: Vec3) -> Result<Vec3, String> {
+    if !e.is_finite() || e.min_element() < 0.0 {
+        return Err(format!("material {name:?}: {what} must be ≥ 0, got {e}"));
+    }
+    if f64::from(e.max_element()) > MAX_RADIANCE {
+        return Err(format!(
+            "material {name:?}: {what} of {:e} is too bright: at most {MAX_RADIANCE:e} per \
+             channel (the numeric range glint supports)",
+            e.max_element()
+        ));
+    }
+    Ok(e)
+}
+
+/// A dielectric's index of refraction within glint's numeric range, as in scene files.
+fn check_ior(name: &str, what: &str, ior: f32) -> Result<f32, String> {
+    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+        return Err(format!(
+            "material {name:?}: {what} must be in [{MIN_IOR}, {MAX_IOR}] (the numeric range \
+             glint supports), got {ior}"
+        ));
+    }
+    Ok(ior)
+}
+
+/// The bytes of a mesh file, if it is a regular file within [`MESH_FILE_LIMIT`].
+fn read_mesh_bytes(path: &Path) -> Result<Vec<u8>, String> {
+    read_regular_file(path, MESH_FILE_LIMIT, "mesh file")
+}
