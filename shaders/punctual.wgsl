@@ -75,7 +75,7 @@ fn punctual_visible(shadow: Ray, light: LightSample) -> bool {
     let t_light = dot(l.position - shadow.origin, shadow.dir);
     if USE_BVH {
         // Any hit nearer than the light ends the search (a target no primitive matches).
-        return bvh_traverse(bvh_ray(shadow), t_light, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
+        return bvh_traverse(bvh_ray(shadow), t_light, t_light, 0u, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
     }
     return closest_primitive(shadow).t >= t_light;
 }

@@ -8,7 +8,7 @@
 use super::bvh::{bvh_ray, bvh_traverse};
 use super::intersect::{closest_primitive, escapes};
 use super::lights::{power_heuristic, LightSample};
-use super::material::{basis, PI};
+use super::frame::{basis, PI};
 use super::trace::SceneRefs;
 use super::Ray;
 use crate::shader_types::{
@@ -96,7 +96,7 @@ pub fn punctual_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) ->
     if !geometry.bvh_nodes.is_empty() {
         // Any hit nearer than the light ends the search (a target no primitive matches).
         let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
-        return bvh_traverse(&geometry, &bvh_ray(shadow), t_light, no_target).t
+        return bvh_traverse(&geometry, &bvh_ray(shadow), t_light, t_light, 0, no_target).t
             == super::intersect::NO_HIT;
     }
     closest_primitive(&geometry, shadow).t >= t_light
