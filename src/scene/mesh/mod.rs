@@ -3,12 +3,19 @@
 //! table). Everything is checked here, before rendering: unreadable or malformed files, vertices
 //! that are not finite, indices out of range, meshes left with no triangles.
 //!
-//! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`); this file holds what they share: the
+//! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`; a glTF file's node hierarchy, cameras
+//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`); this file holds what they share: the
 //! parts a file yields, the material checks, and turning parts into scene triangles.
 
 mod gltf;
+mod gltf_cameras;
+mod gltf_lights;
+mod gltf_nodes;
 mod obj;
 mod ply;
+
+pub use gltf_cameras::{gltf_camera, no_such_camera, FileCamera};
+pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{TextureSet, TextureUse};
