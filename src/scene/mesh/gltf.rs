@@ -38,7 +38,7 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
 ];
 
 /// Extensions glint reads entirely; any other the file uses gets a warning.
-const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization"];
+const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
 
 /// Decoded vertex data may reach this many bytes per byte of the file's buffers (plus
 /// [`DECODE_SLACK`]): a byte index becomes a u32, a byte normal component an f32. It bounds

@@ -123,7 +123,7 @@ fn view(root: &json::Root, p: &Placed) -> Result<FileCamera, String> {
         a => a,
     };
     let eye = p.transform.transform_point3(Vec3::ZERO);
-    if !(eye.abs().max_element() <= MAX_COORDINATE) {
+    if !eye.is_finite() || eye.abs().max_element() > MAX_COORDINATE {
         return Err(format!(
             "nodes[{}]: the camera's position {eye} is outside ±{MAX_COORDINATE:e} (the \
              numeric range glint supports)",

@@ -29,6 +29,16 @@ use std::rc::Rc;
 /// fit any GPU's storage binding anyway.
 pub const MAX_TRIANGLES: usize = 1 << 28;
 
+/// Whether `path` names a glTF file (`.gltf`, `.glb`), by its extension.
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| matches!(e.to_string_lossy().to_lowercase().as_str(), "gltf" | "glb"))
+}
+
+/// The start of the error for a part without a material (a model file gives those parts a
+/// default material instead, `src/scene/model.rs`).
+pub const NO_MATERIAL: &str = "the file gives no material for these triangles";
+
 /// Where a mesh goes in the scene: scale, then rotate about x, y, z (degrees), then translate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshTransform {
@@ -95,7 +105,7 @@ pub(super) struct MeshFile {
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
-pub(super) struct LoadedMesh {
+pub(crate) struct LoadedMesh {
     pub triangles: Vec<Triangle>,
     /// One line each, for stderr.
     pub warnings: Vec<String>,
@@ -103,7 +113,7 @@ pub(super) struct LoadedMesh {
 
 /// Reads, checks, transforms and materials one mesh file. `scene_materials` receives the file's
 /// own materials when `material` is `None`, named `<file name>/<material name>`.
-pub(super) fn load(
+pub(crate) fn load(
     path: &Path,
     shown: &str,
     transform: &MeshTransform,
@@ -185,7 +195,7 @@ pub(super) fn load(
             None => {
                 let Some(index) = part.material else {
                     return Err(format!(
-                        "{shown}: {}the file gives no material for these triangles; set `material` in [[meshes]]",
+                        "{shown}: {}{NO_MATERIAL}; set `material` in [[meshes]]",
                         part_prefix(&part.name)
                     ));
                 };
