@@ -1,5 +1,6 @@
 //! `glint render`.
 
+use super::model::ModelArgs;
 use super::post::PostArgs;
 use super::render_writer::RenderWriter;
 use super::sample_range::{self, SampleRangeArgs};
@@ -13,9 +14,9 @@ use crate::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
     relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
 };
-use crate::scene::{
-    KernelScene, RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
-};
+use crate::scene::model::ModelScene;
+use crate::scene::model_toml::model_toml;
+use crate::scene::{KernelScene, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use crate::shader_types::Params;
 use anyhow::Result;
 use clap::Args;
@@ -30,7 +31,7 @@ const BATCH_TARGET: Duration = Duration::from_millis(250);
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model file (.glb, .gltf, .obj, .ply) to render as a scene.
     pub scene: PathBuf,
     /// Output image: .png (clamped, sRGB) or .exr (linear float32 radiance). Default: <scene stem>.png
     #[arg(short, long)]
@@ -78,6 +79,12 @@ pub struct RenderArgs {
     pub json: bool,
     #[command(flatten)]
     pub post: PostArgs,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Model files: write the scene glint builds from the file as a scene file (TOML) on
+    /// stdout, and render nothing.
+    #[arg(long)]
+    pub print_scene: bool,
     #[command(flatten)]
     pub range: SampleRangeArgs,
     /// Refresh the output with the running image (a resumable partial file for .exr) every
@@ -134,7 +141,7 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let started = Instant::now();
-    let scene = Scene::load(&args.scene).map_err(InputError::from)?;
+    let (scene, model) = args.model.load(&args.scene, args.width, args.height)?;
     let overrides = RenderOverrides {
         width: args.width,
         height: args.height,
@@ -146,6 +153,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let scene = scene
         .with_overrides(&overrides)
         .map_err(|m| InputError(format!("{}: {m}", args.scene.display())))?;
+    if args.print_scene {
+        let Some(model) = model else {
+            return Err(InputError(format!(
+                "--print-scene writes the scene built from a model file; {} is a scene file \
+                 already",
+                args.scene.display()
+            ))
+            .into());
+        };
+        crate::outln!("{}", model_toml(&ModelScene { scene, ..model }).trim_end());
+        return Ok(());
+    }
     let range = &args.range;
     args.post.refuse_partial(
         range.samples.is_some() || range.shard.is_some() || range.resume.is_some(),

@@ -1,5 +1,6 @@
 //! `glint view`.
 
+use super::model::ModelArgs;
 use super::tone::ToneArgs;
 use crate::error::InputError;
 use crate::scene::MAX_IMAGE_SIDE;
@@ -10,7 +11,8 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// Scene file (TOML); edits on disk are picked up while the window is open.
+    /// Scene file (TOML), or a model file (.glb, .gltf, .obj, .ply) to view as a scene; edits
+    /// on disk are picked up while the window is open.
     pub scene: PathBuf,
     /// Window and image width in pixels (overrides [render] width).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64), allow_negative_numbers = true)]
@@ -29,6 +31,8 @@ pub struct ViewArgs {
     pub screenshot: Option<PathBuf>,
     #[command(flatten)]
     pub tone: ToneArgs,
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Tests: actions to inject before given frames, e.g. "5:orbit 40 0; 10:reload".
     #[arg(long, hide = true)]
     pub script: Option<String>,
@@ -42,7 +46,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
         Some(text) => Script::parse(text).map_err(|e| InputError(format!("--script: {e}")))?,
         None => Script::default(),
     };
+    args.model.refuse_for_scene_file(&args.scene)?;
     crate::viewer::run(ViewOptions {
+        model: args.model.options(args.width, args.height),
         scene: args.scene,
         width: args.width,
         height: args.height,

@@ -11,6 +11,7 @@ use super::{ViewOptions, FRAME_TARGET};
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::{Image, ImageFormat};
 use crate::render::{BatchSizer, Renderer};
+use crate::scene::model::load_scene_or_model;
 use crate::scene::{
     place_camera, Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS,
     MAX_SPP,
@@ -47,7 +48,7 @@ pub fn run(
     let display = options.display;
     let mut app = App {
         watch: FileWatch::new(&options.scene),
-        loader: BackgroundLoad::new(&options.scene),
+        loader: BackgroundLoad::new(&options.scene).with_model(options.model.clone()),
         sizer: BatchSizer::new(FRAME_TARGET),
         file_camera: scene.camera.clone(),
         camera: scene.camera.clone(),
@@ -429,7 +430,7 @@ impl App {
 
     /// Re-reads the scene file now (scripted reloads; edits go through [`BackgroundLoad`]).
     fn reload(&mut self) -> Result<()> {
-        let loaded = Scene::load(&self.options.scene);
+        let loaded = load_scene_or_model(&self.options.scene, &self.options.model);
         self.apply_loaded(loaded)
     }
 
