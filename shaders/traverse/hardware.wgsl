@@ -25,42 +25,56 @@ fn hardware_bound(t: f32) -> f32 {
 // The hardware counterpart of bvh_traverse, with the same meaning: the closest primitive that
 // comes before the bound (t_max, max_reference) by the closest-hit rule, or with
 // `shadow_target` not NO_PRIMITIVE, the first other primitive before it (t = NO_HIT when none).
-// A closest-hit search commits each new best hit so the hardware stops looking beyond it:
-// a box at hardware_bound(t), a triangle at the hardware's own t.
+//
+// The hardware stops looking beyond what is committed. A box's hit is committed at
+// hardware_bound(t), so everything the rule may put before it is still proposed. A triangle's
+// could only be committed at the hardware's own t, which rounding can put before a triangle
+// the rule prefers (a neighbour hit at the same edge, an ulp nearer by hit_triangle): it is
+// never committed; instead the query starts over, reaching only to hardware_bound(t).
 fn hardware_traverse(ray: Ray, t_max: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
     let r = bvh_ray(ray);
     var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u);
     var best_reference = max_reference;
     var found = false;
-    var committed = hardware_bound(t_max);
+    var reach = hardware_bound(t_max);
     var rq: ray_query;
-    rayQueryInitialize(&rq, scene_tlas, RayDesc(RAY_FLAG_FORCE_NO_OPAQUE, 0xffu, 0.0, committed, ray.origin, ray.dir));
     loop {
-        let proceed = rayQueryProceed(&rq);
-        if !proceed {
-            break;
-        }
-        let candidate = rayQueryGetCandidateIntersection(&rq);
-        let reference = hardware_references[candidate.instance_custom_data + candidate.primitive_index];
-        let t = hit_primitive(reference, r);
-        if hit_comes_first(t, reference, best.t, best_reference) && reference != shadow_target {
+        rayQueryInitialize(&rq, scene_tlas, RayDesc(RAY_FLAG_FORCE_NO_OPAQUE, 0xffu, 0.0, reach, ray.origin, ray.dir));
+        var committed = reach;
+        var again = false;
+        loop {
+            let proceed = rayQueryProceed(&rq);
+            if !proceed {
+                break;
+            }
+            let candidate = rayQueryGetCandidateIntersection(&rq);
+            let reference = hardware_references[candidate.instance_custom_data + candidate.primitive_index];
+            let t = hit_primitive(reference, r);
+            if !hit_comes_first(t, reference, best.t, best_reference) || reference == shadow_target {
+                continue;
+            }
             best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK);
             best_reference = reference;
             found = true;
             if shadow_target != NO_PRIMITIVE {
                 rayQueryTerminate(&rq);
+                return best;
+            }
+            // Computed before the store: naga 30 does not emit the expressions of
+            // rayQueryGenerateIntersection's argument itself, so they must be emitted first.
+            let bound = min(hardware_bound(t), committed);
+            committed = bound;
+            if candidate.kind == RAY_QUERY_INTERSECTION_AABB {
+                rayQueryGenerateIntersection(&rq, bound);
+            } else if bound < reach {
+                reach = bound;
+                again = true;
+                rayQueryTerminate(&rq);
                 break;
             }
-            if candidate.kind == RAY_QUERY_INTERSECTION_AABB {
-                // Computed before the store: naga 30 does not emit the argument's own
-                // expressions before a rayQueryGenerateIntersection, so they must be emitted.
-                let hit_t = min(hardware_bound(t), committed);
-                committed = hit_t;
-                rayQueryGenerateIntersection(&rq, hit_t);
-            } else {
-                committed = candidate.t;
-                rayQueryConfirmIntersection(&rq);
-            }
+        }
+        if !again {
+            break;
         }
     }
     if !found {

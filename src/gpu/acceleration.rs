@@ -18,7 +18,8 @@ use wgpu::util::DeviceExt;
 /// The scene's primitives as the hardware takes them, before upload.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct HardwareGeometry {
-    /// Three vertices per triangle (no index buffer), in `triangle_references`' order.
+    /// Three vertices per triangle (no index buffer), in `triangle_references`' order: each
+    /// triangle widened in its plane ([`widened_triangle`]).
     pub vertices: Vec<[f32; 3]>,
     pub triangle_references: Vec<u32>,
     /// (min, max) per sphere or quad, in `box_references`' order.
@@ -37,6 +38,35 @@ fn padded_box(min: Vec3, max: Vec3) -> [f32; 6] {
     let pad = Vec3::splat(size * BOX_PADDING + f32::MIN_POSITIVE);
     let (min, max) = (min - pad, max + pad);
     [min.x, min.y, min.z, max.x, max.y, max.z]
+}
+
+/// The triangle (a, b, c) with each edge moved outward in its plane by 2⁻¹⁴ of the size of
+/// its coordinates (and its longest edge): the hardware's triangle test rounds differently from
+/// glint's watertight one (shaders/triangle.wgsl), and a ray through an edge that glint's test
+/// gives to one triangle could otherwise find the hardware proposing neither of the two (as
+/// measured on lavapipe). Widened, the hardware proposes every triangle glint's test hits, and
+/// the few beyond, near the edges, glint's test rejects. A degenerate triangle (no plane), which
+/// glint's test never hits, is kept as it is.
+pub fn widened_triangle(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [[f32; 3]; 3] {
+    use glam::DVec3;
+    let p = [a, b, c].map(|v| DVec3::from(v.map(f64::from)));
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if !(n.length_squared() > 0.0) || !n.is_finite() {
+        return [a, b, c];
+    }
+    let size = p.iter().map(|v| v.abs().max_element()).fold(0.0, f64::max)
+        + (0..3)
+            .map(|i| (p[(i + 1) % 3] - p[i]).length())
+            .fold(0.0, f64::max);
+    let delta = size / 16384.0;
+    // The outward normal, in the plane, of the edge from vertex i to vertex i + 1.
+    let outward = |i: usize| (p[(i + 1) % 3] - p[i]).cross(n).normalize();
+    std::array::from_fn(|i| {
+        // The edges into and out of vertex i, each moved out by delta, meet here.
+        let (m1, m2) = (outward((i + 2) % 3), outward(i));
+        let moved = p[i] + delta * (m1 + m2) / (1.0 + m1.dot(m2)).max(1e-6);
+        moved.as_vec3().to_array()
+    })
 }
 
 impl HardwareGeometry {
@@ -61,7 +91,7 @@ impl HardwareGeometry {
             match reference >> PRIMITIVE_KIND_SHIFT {
                 PRIMITIVE_TRIANGLE => {
                     let t = &scene.triangles[index];
-                    geometry.vertices.extend([t.v0, t.v1, t.v2]);
+                    geometry.vertices.extend(widened_triangle(t.v0, t.v1, t.v2));
                     geometry.triangle_references.push(reference);
                 }
                 PRIMITIVE_SPHERE => {
@@ -256,4 +286,29 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
         _inputs: inputs,
         build_seconds: started.elapsed().as_secs_f64(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A widened triangle holds the original one with a margin of at least delta on each
+    /// edge, and stays in its plane.
+    #[test]
+    fn widened_triangles_hold_the_original_with_a_margin() {
+        let (a, b, c) = ([0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
+        let w = widened_triangle(a, b, c);
+        let delta = (4.0 + 4.0) / 16384.0;
+        assert!(w.iter().all(|v| v[2] == 0.0));
+        // The right angle at a moves by delta along both axes, outward.
+        assert!((w[0][0] + delta).abs() < 1e-6 && (w[0][1] + delta).abs() < 1e-6);
+        // Each widened edge line is delta beyond the original one: the hypotenuse's too.
+        let n = glam::Vec2::new(2.0, 4.0).normalize();
+        let offset =
+            |v: [f32; 3]| glam::Vec2::new(v[0], v[1]).dot(n) - glam::Vec2::new(4.0, 0.0).dot(n);
+        assert!((offset(w[1]) - delta).abs() < 1e-5 && (offset(w[2]) - delta).abs() < 1e-5);
+        // A degenerate triangle is kept.
+        let line = [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0]];
+        assert_eq!(widened_triangle(line[0], line[1], line[2]), line);
+    }
 }
