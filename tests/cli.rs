@@ -618,3 +618,54 @@ fn missing_shader_cache_folders_are_created() {
     );
     assert!(cache.is_dir(), "{} was not created", cache.display());
 }
+
+/// `--traversal`: `software` and `auto` render everywhere, `hardware` where the device has
+/// ray queries (else exit 1, naming why, and no file); `--json` says which ran, and on lavapipe
+/// `auto` is the software traversal (measured slower there: BENCHMARKS.md). Both traversals
+/// write the same image, bit for bit. The CPU reference always reports `software`.
+#[test]
+fn traversal_flag_picks_and_reports_the_traversal() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let run = |output: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            cornell.to_str().unwrap(),
+            "-o",
+            output,
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            "2",
+            "--json",
+        ];
+        args.extend(extra);
+        glint(dir.path(), &args)
+    };
+    let cpu = json(&run("cpu.png", &["--cpu", "--traversal", "hardware"]));
+    assert_eq!(cpu["traversal"], "software");
+    let bad = run("bad.png", &["--traversal", "sideways"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(!dir.path().join("bad.png").exists());
+    let Some(ctx) = common::gpu() else { return };
+    let software = json(&run("software.png", &["--gpu", "--traversal", "software"]));
+    assert_eq!(software["traversal"], "software");
+    let auto = json(&run("auto.png", &["--gpu"]));
+    if ctx.device_name().contains("llvmpipe") {
+        assert_eq!(auto["traversal"], "software");
+    }
+    let hardware = run("hardware.png", &["--gpu", "--traversal", "hardware"]);
+    if ctx.has_ray_queries() {
+        assert_eq!(json(&hardware)["traversal"], "hardware");
+        assert_eq!(
+            std::fs::read(dir.path().join("hardware.png")).unwrap(),
+            std::fs::read(dir.path().join("software.png")).unwrap()
+        );
+    } else {
+        assert_eq!(hardware.status.code(), Some(1));
+        assert!(String::from_utf8_lossy(&hardware.stderr).contains("no ray queries"));
+        assert!(!dir.path().join("hardware.png").exists());
+    }
+}
