@@ -298,7 +298,8 @@ mod tests {
     fn widened_triangles_hold_the_original_with_a_margin() {
         let (a, b, c) = ([0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 2.0, 0.0]);
         let w = widened_triangle(a, b, c);
-        let delta = (4.0 + 4.0) / 16384.0;
+        // 2⁻¹⁴ of the largest coordinate (4) and the longest edge (√20).
+        let delta = (4.0 + 20f32.sqrt()) / 16384.0;
         assert!(w.iter().all(|v| v[2] == 0.0));
         // The right angle at a moves by delta along both axes, outward.
         assert!((w[0][0] + delta).abs() < 1e-6 && (w[0][1] + delta).abs() < 1e-6);
