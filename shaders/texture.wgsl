@@ -88,17 +88,21 @@ fn texture_lookup(index: u32, uv: vec2<f32>) -> vec3<f32> {
     return image_lookup(t, uv);
 }
 
-// The material at a hit with texture coordinates uv: textured colour and roughness replace
-// the constant ones, before any BSDF or AOV reads them.
+// The material at a hit with texture coordinates uv: textures multiply the constants (glTF's
+// rule; a TOML texture's constant is 1), before any BSDF or AOV reads them. A roughness
+// texture holds the roughness in x and the metallic factor in y (1 where the image gives none,
+// src/scene/texture.rs).
 fn material_at(m: Material, uv: vec2<f32>) -> Material {
     var out = m;
     if HAS_TEXTURES {
         if m.color_texture != NO_TEXTURE {
-            out.albedo = texture_lookup(m.color_texture, uv);
+            out.albedo = m.albedo * texture_lookup(m.color_texture, uv);
         }
         if m.roughness_texture != NO_TEXTURE {
-            let roughness = texture_lookup(m.roughness_texture, uv).x;
-            out.alpha = roughness * roughness;
+            let t = texture_lookup(m.roughness_texture, uv);
+            // alpha = (roughness t.x)^2, roughness^2 being the constant's alpha.
+            out.alpha = m.alpha * (t.x * t.x);
+            out.metallic = m.metallic * t.y;
         }
     }
     return out;

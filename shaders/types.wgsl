@@ -90,9 +90,9 @@ struct Material {
     // GGX alpha (roughness squared) for metal.
     alpha: f32,
     ior: f32,
-    // Texture replacing albedo at the hit, or NO_TEXTURE (texture.wgsl).
+    // Texture multiplying albedo at the hit, or NO_TEXTURE (texture.wgsl).
     color_texture: u32,
-    // Texture whose first channel replaces the metal's roughness (alpha = r * r), or NO_TEXTURE.
+    // Texture whose x multiplies the roughness (alpha by x * x) and y metallic, or NO_TEXTURE.
     roughness_texture: u32,
     // PBR: the conductor's share.
     metallic: f32,

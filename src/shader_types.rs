@@ -106,9 +106,9 @@ pub struct Material {
     /// GGX alpha (roughness squared) for metal.
     pub alpha: f32,
     pub ior: f32,
-    /// Index into the texture descriptors replacing `albedo` at the hit, or [`NO_TEXTURE`].
+    /// Index into the texture descriptors multiplying `albedo` at the hit, or [`NO_TEXTURE`].
     pub color_texture: u32,
-    /// Texture whose first channel replaces the metal's roughness (alpha = r²), or [`NO_TEXTURE`].
+    /// Texture whose x multiplies the roughness (alpha by x²) and y `metallic`, or [`NO_TEXTURE`].
     pub roughness_texture: u32,
     /// PBR: the conductor's share.
     pub metallic: f32,

@@ -192,9 +192,13 @@ fn srgb_textures_are_linearised_and_data_textures_are_not() {
             "{device}"
         );
     }
+    // A roughness texture holds the roughness in x and the metallic factor, 1, in y.
     for (device, values) in lookups(&scene, m.roughness_texture, &[at]) {
         assert!(
-            (values[0] - Vec3::splat(128.0 / 255.0)).abs().max_element() < 1e-7,
+            (values[0] - Vec3::new(128.0 / 255.0, 1.0, 1.0))
+                .abs()
+                .max_element()
+                < 1e-7,
             "{device}"
         );
     }

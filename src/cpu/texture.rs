@@ -116,16 +116,20 @@ pub fn texture_lookup(textures: &Textures, index: u32, uv: Vec2) -> Vec3 {
     image_lookup(textures, t, uv)
 }
 
-/// The material at a hit with texture coordinates `uv`: textured colour and roughness replace
-/// the constant ones, before any BSDF or AOV reads them.
+/// The material at a hit with texture coordinates `uv`: textures multiply the constants
+/// (glTF's rule; a TOML texture's constant is 1), before any BSDF or AOV reads them. A
+/// roughness texture holds the roughness in x and the metallic factor in y (1 where the
+/// image gives none, `src/scene/texture.rs`).
 pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
     let mut out = *m;
     if m.color_texture != NO_TEXTURE {
-        out.albedo = texture_lookup(textures, m.color_texture, uv).into();
+        out.albedo = (Vec3::from(m.albedo) * texture_lookup(textures, m.color_texture, uv)).into();
     }
     if m.roughness_texture != NO_TEXTURE {
-        let roughness = texture_lookup(textures, m.roughness_texture, uv).x;
-        out.alpha = roughness * roughness;
+        let t = texture_lookup(textures, m.roughness_texture, uv);
+        // alpha = (roughness · t.x)², roughness² being the constant's alpha.
+        out.alpha = m.alpha * (t.x * t.x);
+        out.metallic = m.metallic * t.y;
     }
     out
 }

@@ -172,9 +172,10 @@ pub struct Material {
     pub color: Vec3,
     /// `emission * strength`.
     pub emitted_radiance: Vec3,
-    /// Index into [`Scene::textures`] replacing `color` at each hit.
+    /// Index into [`Scene::textures`] multiplying `color` at each hit (1 for TOML textures).
     pub color_texture: Option<u32>,
-    /// Index into [`Scene::textures`] whose first channel replaces a metal's roughness.
+    /// Index into [`Scene::textures`] whose first channel multiplies the roughness (1 for TOML
+    /// textures) and whose second multiplies a pbr material's `metallic`.
     pub roughness_texture: Option<u32>,
 }
 

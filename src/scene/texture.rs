@@ -3,7 +3,7 @@
 //! descriptor per texture and every image's texels in one array, bottom row first, so texture
 //! coordinates (v up) index rows directly.
 
-use super::image::{load_linear_image, Encoding};
+use super::image::{decode_linear_image, load_linear_image, Encoding, LinearImage};
 use crate::shader_types::{Texture, TEXTURE_CHECKER, TEXTURE_IMAGE};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -17,8 +17,11 @@ pub const MAX_TOTAL_TEXELS: u64 = u32::MAX as u64;
 pub enum TextureUse {
     /// A reflectance: sRGB-decoded (PNG, JPEG), every channel in [0, 1].
     Color,
-    /// Metal roughness: linear (not sRGB-decoded), the first channel in [0, 1].
+    /// Roughness (metal, pbr): linear (not sRGB-decoded), the first channel in [0, 1].
     Roughness,
+    /// glTF's metallicRoughnessTexture: linear, roughness in green and metallic in blue, both
+    /// in [0, 1].
+    MetallicRoughness,
 }
 
 /// Every texture of a scene, as the kernel reads them.
@@ -49,24 +52,59 @@ impl TextureSet {
         if let Some(&index) = self.loaded.get(&key) {
             return Ok(index);
         }
-        let encoding = match usage {
-            TextureUse::Color => Encoding::Srgb,
-            TextureUse::Roughness => Encoding::Linear,
-        };
-        let image = load_linear_image(path, encoding)?;
+        let image = load_linear_image(path, encoding(usage))?;
+        self.add(key, &path.display().to_string(), image, usage)
+    }
+
+    /// The texture of an image file's bytes embedded in `file` as `element` (a glTF file's
+    /// `images[2]`), decoded and checked like an image file the first time it is asked for.
+    pub fn embedded_image(
+        &mut self,
+        file: &Path,
+        element: &str,
+        bytes: &[u8],
+        usage: TextureUse,
+    ) -> Result<u32, String> {
+        let file = file.canonicalize().unwrap_or_else(|_| file.to_owned());
+        let shown = format!("{}: {element}", file.display());
+        // A key no file path has: the file's path with the element after a '#'.
+        let key = (
+            PathBuf::from(format!("{}#{element}", file.display())),
+            usage,
+        );
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        let image = decode_linear_image(bytes, encoding(usage))?;
+        self.add(key, &shown, image, usage)
+    }
+
+    /// Checks a decoded image's texels for `usage` and appends it; `shown` names it in warnings.
+    fn add(
+        &mut self,
+        key: (PathBuf, TextureUse),
+        shown: &str,
+        image: LinearImage,
+        usage: TextureUse,
+    ) -> Result<u32, String> {
         if let Some(clamped) = image.clamped {
             self.warnings
-                .push(format!("{}: {}", path.display(), clamped.warning()));
+                .push(format!("{shown}: {}", clamped.warning()));
         }
+        // The channels the use reads.
         let channels = match usage {
-            TextureUse::Color => 3,
-            TextureUse::Roughness => 1,
+            TextureUse::Color => 0..3,
+            TextureUse::Roughness => 0..1,
+            TextureUse::MetallicRoughness => 1..3,
         };
         // Rows from the top (as files store them) to rows from the bottom.
         for y in 0..image.height {
             for x in 0..image.width {
                 let texel = image.texel(x, image.height - 1 - y);
-                if let Some(&bad) = texel[..channels].iter().find(|c| !(0.0..=1.0).contains(*c)) {
+                if let Some(&bad) = texel[channels.clone()]
+                    .iter()
+                    .find(|c| !(0.0..=1.0).contains(*c))
+                {
                     return Err(format!(
                         "texel ({x}, {}) (from the top left) is {bad}; a {} texture's values must \
                          be in [0, 1]",
@@ -74,6 +112,7 @@ impl TextureSet {
                         match usage {
                             TextureUse::Color => "color",
                             TextureUse::Roughness => "roughness",
+                            TextureUse::MetallicRoughness => "metallic-roughness",
                         }
                     ));
                 }
@@ -90,7 +129,13 @@ impl TextureSet {
         for y in (0..image.height).rev() {
             for x in 0..image.width {
                 let [r, g, b] = image.texel(x, y);
-                self.texels.push([r, g, b, 0.0]);
+                // Roughness textures as the kernel reads them: x the roughness, y the
+                // metallic factor (1 where the texture gives none).
+                self.texels.push(match usage {
+                    TextureUse::Color => [r, g, b, 0.0],
+                    TextureUse::Roughness => [r, 1.0, 1.0, 0.0],
+                    TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
+                });
             }
         }
         let index = self.push(Texture {
@@ -119,5 +164,12 @@ impl TextureSet {
     fn push(&mut self, texture: Texture) -> u32 {
         self.descriptors.push(texture);
         self.descriptors.len() as u32 - 1
+    }
+}
+
+fn encoding(usage: TextureUse) -> Encoding {
+    match usage {
+        TextureUse::Color => Encoding::Srgb,
+        TextureUse::Roughness | TextureUse::MetallicRoughness => Encoding::Linear,
     }
 }

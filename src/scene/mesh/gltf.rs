@@ -13,8 +13,8 @@
 //! bounds set by the file's real size. Each error names the element (`accessors[3]`).
 
 use super::{
-    check_emission, check_ior, check_reflectance, one_line, read_mesh_bytes, Geometry, MeshFile,
-    MeshPart, MAX_TRIANGLES,
+    check_emission, check_ior, check_reflectance, one_line, read_mesh_bytes, FileTextures,
+    Geometry, ImageSource, MeshFile, MeshPart, MAX_TRIANGLES,
 };
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Material, MaterialKind};
@@ -32,6 +32,7 @@ use std::rc::Rc;
 const REQUIRABLE_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_mesh_quantization",
 ];
@@ -71,12 +72,26 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     let instances = instances(&root)?;
 
     let mut materials = Vec::new();
-    let mut color_textures = Vec::new();
+    let mut textures = Vec::new();
     let mut has_other_textures = false;
+    // Each image read once, however many materials use it.
+    let mut images: Vec<Option<Rc<ImageSource>>> = vec![None; root.images.len()];
     for (i, m) in root.materials.iter().enumerate() {
-        let (material, color_texture, other_textures) = material(&root, m, i, dir)?;
+        let (material, maps, other_textures) = material(&root, m, i, &mut warnings)?;
+        let mut source = |image: Option<usize>| -> Result<_, String> {
+            let Some(i) = image else {
+                return Ok(None);
+            };
+            if images[i].is_none() {
+                images[i] = Some(Rc::new(image_source(&root, &buffers, i, dir)?));
+            }
+            Ok(images[i].clone())
+        };
+        textures.push(FileTextures {
+            color: source(maps.color)?,
+            metallic_roughness: source(maps.metallic_roughness)?,
+        });
         materials.push(material);
-        color_textures.push(color_texture);
         has_other_textures |= other_textures;
     }
 
@@ -128,7 +143,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     Ok(MeshFile {
         parts,
         materials,
-        color_textures,
+        textures,
         has_other_textures,
         warnings,
     })
@@ -455,36 +470,65 @@ fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
 }
 
 /// A glTF material as glint's, its colour texture's file, and whether it has other textures:
-/// `pbrMetallicRoughness`: baseColorFactor; metallicFactor ≥ 0.5 → metal with
-/// roughnessFactor, else diffuse; KHR_materials_transmission > 0.5 → dielectric with
-/// KHR_materials_ior (default 1.5); emissiveFactor × KHR_materials_emissive_strength → emission.
+/// `pbrMetallicRoughness` (baseColorFactor, metallicFactor, roughnessFactor, with glTF's
+/// defaults), KHR_materials_ior and KHR_materials_specular's factors → `pbr`;
+/// KHR_materials_transmission > 0 → dielectric with the ior (glint has no rough or partly
+/// transmissive dielectric yet: a warning says so); emissiveFactor ×
+/// KHR_materials_emissive_strength → emission. Warning lines go to `warnings`.
 fn material(
     root: &json::Root,
     m: &json::Material,
     index: usize,
-    dir: &Path,
-) -> Result<(Material, Option<PathBuf>, bool), String> {
+    warnings: &mut Vec<String>,
+) -> Result<(Material, MaterialImages, bool), String> {
     let name = format!("material{index}");
     let extensions = m.extensions.as_ref();
     let pbr = &m.pbr_metallic_roughness;
     let transmission = extensions
         .and_then(|e| e.transmission.as_ref())
         .map(|t| t.transmission_factor.0);
-    let kind = if transmission.is_some_and(|t| t > 0.5) {
-        let ior = extensions
-            .and_then(|e| e.ior.as_ref())
-            .map(|i| i.ior.0)
-            .filter(|&n| n > 0.0)
-            .unwrap_or(1.5);
-        MaterialKind::Dielectric {
-            ior: check_ior(&name, "KHR_materials_ior", ior)?,
-        }
-    } else if pbr.metallic_factor.0 >= 0.5 {
-        MaterialKind::Metal {
-            roughness: pbr.roughness_factor.0.clamp(0.0, 1.0),
-        }
+    // glTF's ior 0 is a special case glint cannot render; its default is 1.5.
+    let ior = extensions
+        .and_then(|e| e.ior.as_ref())
+        .map(|i| i.ior.0)
+        .filter(|&n| n > 0.0)
+        .unwrap_or(1.5);
+    let ior = check_ior(&name, "KHR_materials_ior", ior)?;
+    let kind = if let Some(t) = transmission.filter(|&t| t > 0.0) {
+        warnings.push(format!(
+            "materials[{index}]: KHR_materials_transmission {t} is rendered as a smooth, fully \
+             transmissive dielectric (ior {ior}); glint has no rough or partly transmissive one \
+             yet"
+        ));
+        MaterialKind::Dielectric { ior }
     } else {
-        MaterialKind::Diffuse
+        let unit = |what: &str, v: f32| {
+            if (0.0..=1.0).contains(&v) {
+                Ok(v)
+            } else {
+                Err(format!(
+                    "material {name:?}: {what} must be in [0, 1], got {v}"
+                ))
+            }
+        };
+        let specular = extensions.and_then(|e| e.specular.as_ref());
+        let specular_color = Vec3::from(specular.map_or([1.0; 3], |s| s.specular_color_factor.0));
+        if !specular_color.is_finite() || specular_color.min_element() < 0.0 {
+            return Err(format!(
+                "material {name:?}: KHR_materials_specular specularColorFactor must be ≥ 0, got \
+                 {specular_color}"
+            ));
+        }
+        MaterialKind::Pbr {
+            roughness: unit("roughnessFactor", pbr.roughness_factor.0)?,
+            metallic: unit("metallicFactor", pbr.metallic_factor.0)?,
+            ior,
+            specular: unit(
+                "KHR_materials_specular specularFactor",
+                specular.map_or(1.0, |s| s.specular_factor.0),
+            )?,
+            specular_color,
+        }
     };
     let color = check_reflectance(
         &name,
@@ -504,25 +548,47 @@ fn material(
         "emissiveFactor × emissive strength",
         Vec3::from(m.emissive_factor.0) * strength,
     )?;
-    // The base colour: an image by URI (relative to the glTF file) on texture coordinate set
-    // 0. Embedded images (buffer views, data URIs) and other sets are not read.
-    let mut color_texture = None;
-    let mut other_textures = pbr.metallic_roughness_texture.is_some()
-        || m.normal_texture.is_some()
-        || m.occlusion_texture.is_some()
-        || m.emissive_texture.is_some();
-    if let Some(info) = &pbr.base_color_texture {
-        let t = exists(info.index.value(), root.textures.len(), "texture").map_err(|e| {
-            format!("materials[{index}].pbrMetallicRoughness.baseColorTexture.index: {e}")
-        })?;
-        let image = &root.images[root.textures[t].source.value()];
-        color_texture = image
-            .uri
-            .as_deref()
-            .filter(|uri| info.tex_coord == 0 && !uri.starts_with("data:"))
-            .and_then(|uri| resolve_uri(uri, dir).ok());
-        // Not read (embedded, on another set, an http: URI): ignored with the others.
-        other_textures |= color_texture.is_none();
+    // Occlusion maps are for rasterisers (a path tracer finds the occlusion), so they are
+    // ignored without a word.
+    let mut other_textures = m.normal_texture.is_some();
+    let mut emission = emission;
+    if m.emissive_texture.is_some() && emission != Vec3::ZERO {
+        warnings.push(format!(
+            "materials[{index}]: emissiveTexture is not read, so the material's emission \
+             (emissiveFactor {}) is left out rather than spread evenly over the surface",
+            Vec3::from(m.emissive_factor.0)
+        ));
+        emission = Vec3::ZERO;
+    }
+    let mut image = |info: &Option<json::texture::Info>, field: &str| {
+        let Some(info) = info else {
+            return Ok(None);
+        };
+        let field = format!("materials[{index}].{field}");
+        let t = exists(info.index.value(), root.textures.len(), "texture")
+            .map_err(|e| format!("{field}.index: {e}"))?;
+        if info.tex_coord != 0 {
+            warnings.push(format!(
+                "{field}: on TEXCOORD_{}; glint reads TEXCOORD_0 only, so the texture is ignored",
+                info.tex_coord
+            ));
+            return Ok(None);
+        }
+        Ok::<_, String>(Some(root.textures[t].source.value()))
+    };
+    let maps = MaterialImages {
+        color: image(
+            &pbr.base_color_texture,
+            "pbrMetallicRoughness.baseColorTexture",
+        )?,
+        metallic_roughness: image(
+            &pbr.metallic_roughness_texture,
+            "pbrMetallicRoughness.metallicRoughnessTexture",
+        )?,
+    };
+    if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
+        other_textures |=
+            specular.specular_texture.is_some() || specular.specular_color_texture.is_some();
     }
     Ok((
         Material {
@@ -533,9 +599,55 @@ fn material(
             color_texture: None,
             roughness_texture: None,
         },
-        color_texture,
+        maps,
         other_textures,
     ))
+}
+
+/// The images (indices into `images`) of a material's texture maps.
+struct MaterialImages {
+    color: Option<usize>,
+    metallic_roughness: Option<usize>,
+}
+
+/// Where image `i` comes from: a file its URI names, or bytes in the glTF file (a buffer view
+/// or a base64 `data:` URI), which must be a PNG or JPEG image as glTF requires.
+fn image_source(
+    root: &json::Root,
+    buffers: &Buffers,
+    i: usize,
+    dir: &Path,
+) -> Result<ImageSource, String> {
+    let element = format!("images[{i}]");
+    let image = &root.images[i];
+    let bytes: Vec<u8> = match (&image.uri, image.buffer_view) {
+        (Some(uri), _) if !uri.starts_with("data:") => {
+            return Ok(ImageSource::File(
+                resolve_uri(uri, dir).map_err(|e| format!("{element}: {e}"))?,
+            ))
+        }
+        (Some(uri), _) => read_uri(uri, dir, "image").map_err(|e| format!("{element}: {e}"))?,
+        (None, Some(v)) => {
+            // Inside its buffer: check_buffer_views saw it fit.
+            let view = &root.buffer_views[v.value()];
+            let start = view.byte_offset.map_or(0, |o| o.0) as usize;
+            buffers.data[view.buffer.value()][start..start + view.byte_length.0 as usize].to_vec()
+        }
+        (None, None) => return Err(format!("{element}: neither a uri nor a bufferView")),
+    };
+    match image::guess_format(&bytes) {
+        Ok(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        Ok(other) => {
+            return Err(format!(
+                "{element}: a {other:?} image; glTF images glint reads are PNG and JPEG"
+            ))
+        }
+        Err(_) => return Err(format!("{element}: not a PNG or JPEG image")),
+    }
+    Ok(ImageSource::Embedded {
+        element,
+        bytes: bytes.into(),
+    })
 }
 
 /// A primitive, checked, with the accessors to read.

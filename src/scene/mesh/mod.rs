@@ -79,12 +79,34 @@ impl MeshPart {
 pub(super) struct MeshFile {
     parts: Vec<MeshPart>,
     materials: Vec<Material>,
-    /// Per material: its colour texture's file (OBJ `map_Kd`, glTF `baseColorTexture` by URI).
-    color_textures: Vec<Option<PathBuf>>,
+    /// Per material: the images of its texture maps.
+    textures: Vec<FileTextures>,
     /// Whether any material refers to a texture glint does not use (normal maps, ...).
     has_other_textures: bool,
     /// Anything else worth a warning line, each a sentence without the file's name.
     warnings: Vec<String>,
+}
+
+/// Where a texture's image comes from.
+pub(super) enum ImageSource {
+    File(PathBuf),
+    /// An image file's bytes inside the mesh file (a glTF buffer view or `data:` URI), and the
+    /// element that holds them (`images[2]`), for messages.
+    Embedded {
+        element: String,
+        bytes: Rc<[u8]>,
+    },
+}
+
+/// A material's texture maps, as images (shared between the materials that use them).
+#[derive(Default)]
+pub(super) struct FileTextures {
+    /// Multiplies the material's colour (OBJ `map_Kd`, whose colour is then 1; glTF
+    /// `baseColorTexture`).
+    color: Option<Rc<ImageSource>>,
+    /// glTF's `metallicRoughnessTexture`: green multiplies the roughness, blue the metallic
+    /// factor.
+    metallic_roughness: Option<Rc<ImageSource>>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -135,7 +157,8 @@ pub(super) fn load(
         .collect();
     if file.has_other_textures {
         warnings.push(format!(
-            "{shown}: texture maps other than the base colour (normal, roughness, emission, ...) are ignored"
+            "{shown}: texture maps other than the base colour and metallic-roughness (normal, \
+             emission, ...) are ignored"
         ));
     }
     // The file's materials become scene materials, but only when they are used.
@@ -186,17 +209,17 @@ pub(super) fn load(
                     Some(m) => m,
                     None => {
                         let mut m = file.materials[index].clone();
-                        if let Some(texture) = &file.color_textures[index] {
-                            let index =
-                                textures.image(texture, TextureUse::Color).map_err(|e| {
-                                    format!(
-                                        "material {:?}: texture {}: {e}",
-                                        m.name,
-                                        texture.display()
-                                    )
-                                })?;
-                            m.color_texture = Some(index);
-                        }
+                        let maps = &file.textures[index];
+                        let name = m.name.clone();
+                        let mut load = |source: &Option<Rc<ImageSource>>, usage| {
+                            source
+                                .as_deref()
+                                .map(|source| texture(source, usage, path, shown, &name, textures))
+                                .transpose()
+                        };
+                        m.color_texture = load(&maps.color, TextureUse::Color)?;
+                        m.roughness_texture =
+                            load(&maps.metallic_roughness, TextureUse::MetallicRoughness)?;
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;
                         scene_materials.push(m);
@@ -267,6 +290,26 @@ pub(super) fn load(
         triangles,
         warnings,
     })
+}
+
+/// The texture of an image a mesh file's material refers to; the error names the material
+/// and the image (its file, or the mesh file and element that hold it).
+fn texture(
+    source: &ImageSource,
+    usage: TextureUse,
+    mesh_path: &Path,
+    shown: &str,
+    material: &str,
+    textures: &mut TextureSet,
+) -> Result<u32, String> {
+    match source {
+        ImageSource::File(file) => textures
+            .image(file, usage)
+            .map_err(|e| format!("material {material:?}: texture {}: {e}", file.display())),
+        ImageSource::Embedded { element, bytes } => textures
+            .embedded_image(mesh_path, element, bytes, usage)
+            .map_err(|e| format!("{shown}: material {material:?}: {element}: {e}")),
+    }
 }
 
 /// A reader's message on one line: runs of whitespace (newlines, tabs) become one space.

@@ -98,7 +98,7 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
             String::new(),
         )],
         materials: Vec::new(),
-        color_textures: Vec::new(),
+        textures: Vec::new(),
         has_other_textures: false,
         warnings: Vec::new(),
     })
