@@ -4,6 +4,7 @@
 
 mod environment;
 mod fields;
+mod lights;
 mod materials;
 mod objects;
 
@@ -189,6 +190,7 @@ impl SceneToml {
             triangles: objects.triangles,
             textures,
             environment,
+            lights: lights::validate_lights(&self.lights)?,
         };
         Ok((scene, warnings))
     }
