@@ -156,6 +156,10 @@ struct Emitter {
 
 const TEXTURE_IMAGE: u32 = 0u;
 const TEXTURE_CHECKER: u32 = 1u;
+const TEXTURE_WRAP_REPEAT: u32 = 0u;
+const TEXTURE_WRAP_CLAMP: u32 = 1u;
+const TEXTURE_WRAP_MIRROR: u32 = 2u;
+const TEXTURE_NEAREST: u32 = 65536u;
 
 // An image whose texels are texels[first_texel ..][.. width * height], bottom row first, or a
 // checker of two colours with `scale` squares per unit of u and of v (texture.wgsl).
@@ -168,6 +172,13 @@ struct Texture {
     color0: vec3<f32>,
     scale: f32,
     color1: vec3<f32>,
+    // Image lookups: TEXTURE_WRAP_* for u in bits 0-7 and for v in bits 8-15, and
+    // TEXTURE_NEAREST for unfiltered lookups.
+    sampling: u32,
+    // The texture coordinates the lookup uses: (dot(transform_u, (u, v, 1)),
+    // dot(transform_v, (u, v, 1))) (glTF's KHR_texture_transform; the identity otherwise).
+    transform_u: vec3<f32>,
+    transform_v: vec3<f32>,
 }
 
 // A triangle's texture coordinates at its three vertices (zero where the mesh has none).

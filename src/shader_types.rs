@@ -193,7 +193,7 @@ pub const TEXTURE_CHECKER: u32 = 1;
 /// whose texels are `texels[first_texel ..][.. width * height]`, bottom row first, or a checker
 /// of two colours with `scale` squares per unit of u and of v.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Texture {
     /// `TEXTURE_IMAGE` or `TEXTURE_CHECKER`.
     pub kind: u32,
@@ -204,7 +204,40 @@ pub struct Texture {
     pub color0: [f32; 3],
     pub scale: f32,
     pub color1: [f32; 3],
-    pub _pad: u32,
+    /// Image lookups: `TEXTURE_WRAP_*` for u in bits 0–7 and for v in bits 8–15, and
+    /// [`TEXTURE_NEAREST`] for unfiltered lookups.
+    pub sampling: u32,
+    /// The texture coordinates the lookup uses: (u', v') = (transform_u · (u, v, 1),
+    /// transform_v · (u, v, 1)) (glTF's KHR_texture_transform; the identity otherwise).
+    pub transform_u: [f32; 3],
+    pub _pad0: u32,
+    pub transform_v: [f32; 3],
+    pub _pad1: u32,
+}
+
+/// [`Texture::sampling`]'s wrap modes (glTF's sampler modes) and its unfiltered flag.
+pub const TEXTURE_WRAP_REPEAT: u32 = 0;
+pub const TEXTURE_WRAP_CLAMP: u32 = 1;
+pub const TEXTURE_WRAP_MIRROR: u32 = 2;
+pub const TEXTURE_NEAREST: u32 = 1 << 16;
+
+impl Default for Texture {
+    fn default() -> Self {
+        Texture {
+            kind: TEXTURE_IMAGE,
+            first_texel: 0,
+            width: 0,
+            height: 0,
+            color0: [0.0; 3],
+            scale: 0.0,
+            color1: [0.0; 3],
+            sampling: 0,
+            transform_u: [1.0, 0.0, 0.0],
+            _pad0: 0,
+            transform_v: [0.0, 1.0, 0.0],
+            _pad1: 0,
+        }
+    }
 }
 
 /// A triangle's texture coordinates at its three vertices (zero where the mesh has none).

@@ -433,3 +433,62 @@ fn a_texture_on_the_second_coordinate_set_is_a_warning() {
         "{warnings:?}"
     );
 }
+
+/// A texture's sampler (wrap modes, magnification filter) and KHR_texture_transform reach its
+/// descriptor, the transform converted to glint's v-up coordinates: for glint's (u, v), the
+/// descriptor's map gives what the extension's T·R·S (written out here independently, the
+/// rotation counterclockwise with v down as its text says and TextureTransformTest.gltf
+/// checks, tests/gltf_samples.rs) gives for glTF's (u, 1 − v), with v flipped back.
+#[test]
+fn samplers_and_texture_transforms_reach_the_descriptor() {
+    use glint::shader_types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
+    let (offset, rotation, scale) = ([0.25f32, -0.5], 0.5f32, [2.0f32, 3.0]);
+    let material = serde_json::json!({"pbrMetallicRoughness": {
+        "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+            "offset": offset, "rotation": rotation, "scale": scale
+        }}}
+    }});
+    let bytes = glb(material, &[png(COLOR_TEXELS)], |g| {
+        g["textures"] = serde_json::json!([{"source": 0, "sampler": 0}]);
+        g["samplers"] = serde_json::json!([{"wrapS": 33071, "wrapT": 33648, "magFilter": 9728}]);
+        g["extensionsUsed"] = serde_json::json!(["KHR_texture_transform"]);
+        g["extensionsRequired"] = serde_json::json!(["KHR_texture_transform"]);
+    });
+    let scene = load_glb(&bytes).unwrap_or_else(|e| panic!("{e}"));
+    let index = scene.triangles[0].material as usize;
+    let scene = scene.kernel_scene();
+    let t = scene.textures[scene.materials[index].color_texture as usize];
+    assert_eq!(
+        t.sampling,
+        TEXTURE_WRAP_CLAMP | (TEXTURE_WRAP_MIRROR << 8) | TEXTURE_NEAREST
+    );
+    let (s, c) = rotation.sin_cos();
+    let translation =
+        glam::Mat3::from_cols_array(&[1., 0., 0., 0., 1., 0., offset[0], offset[1], 1.]);
+    let rotate = glam::Mat3::from_cols_array(&[c, -s, 0., s, c, 0., 0., 0., 1.]);
+    let scaling = glam::Mat3::from_cols_array(&[scale[0], 0., 0., 0., scale[1], 0., 0., 0., 1.]);
+    let matrix = translation * rotate * scaling;
+    for uv in [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0], [0.3, 0.7]] {
+        let gltf = matrix * Vec3::new(uv[0], 1.0 - uv[1], 1.0);
+        let want = glam::Vec2::new(gltf.x, 1.0 - gltf.y);
+        let got = glint::cpu::texture::transformed_uv(&t, glam::Vec2::from(uv));
+        assert!(
+            (got - want).abs().max_element() < 1e-5,
+            "at {uv:?}: {got} against {want}"
+        );
+    }
+}
+
+/// A sampler's wrap mode that is not one of glTF's is an error naming the sampler.
+#[test]
+fn an_unknown_wrap_mode_is_an_error() {
+    let material = serde_json::json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}});
+    let bytes = glb(material, &[png(COLOR_TEXELS)], |g| {
+        g["textures"] = serde_json::json!([{"source": 0, "sampler": 0}]);
+        g["samplers"] = serde_json::json!([{"wrapT": 1234}]);
+    });
+    let message = load_glb(&bytes).expect_err("the file should be refused");
+    for needle in ["t.glb", "samplers[0].wrapT", "wrap mode"] {
+        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    }
+}

@@ -204,7 +204,18 @@ fn rust_structs_match_wgsl_layout() {
         &module,
         Texture,
         "Texture",
-        [kind, first_texel, width, height, color0, scale, color1]
+        [
+            kind,
+            first_texel,
+            width,
+            height,
+            color0,
+            scale,
+            color1,
+            sampling,
+            transform_u,
+            transform_v
+        ]
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
     assert_eq!(size_of::<Material>(), 64, "Material stays 64 bytes");

@@ -4,13 +4,36 @@
 //! coordinates (v up) index rows directly.
 
 use super::image::{decode_linear_image, load_linear_image, Encoding, LinearImage};
-use crate::shader_types::{Texture, TEXTURE_CHECKER, TEXTURE_IMAGE};
+use crate::shader_types::{
+    Texture, TEXTURE_CHECKER, TEXTURE_IMAGE, TEXTURE_NEAREST, TEXTURE_WRAP_REPEAT,
+};
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// Most texels of all textures together: the descriptors index them with a u32.
 pub const MAX_TOTAL_TEXELS: u64 = u32::MAX as u64;
+
+/// How a glTF texture reference reads its image: its sampler's wrap modes (`TEXTURE_WRAP_*`,
+/// for u and v) and filter, and KHR_texture_transform's affine map of (u, v, 1), in glint's
+/// texture coordinates (v up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampling {
+    pub wrap: [u32; 2],
+    pub nearest: bool,
+    pub transform: [[f32; 3]; 2],
+}
+
+impl Default for Sampling {
+    /// Repeat, bilinear, untransformed: what TOML textures use.
+    fn default() -> Self {
+        Sampling {
+            wrap: [TEXTURE_WRAP_REPEAT; 2],
+            nearest: false,
+            transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        }
+    }
+}
 
 /// What a texture is read for, which decides its decoding and the range its texels must lie in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -159,6 +182,21 @@ impl TextureSet {
             color1: colors[1].into(),
             ..Default::default()
         })
+    }
+
+    /// Texture `base` (an image) looked up with `sampling`: a descriptor of its own sharing the
+    /// image's texels, or `base` itself when the sampling is the default.
+    pub fn sampled(&mut self, base: u32, sampling: &Sampling) -> u32 {
+        if *sampling == Sampling::default() {
+            return base;
+        }
+        let mut texture = self.descriptors[base as usize];
+        texture.sampling = sampling.wrap[0]
+            | (sampling.wrap[1] << 8)
+            | if sampling.nearest { TEXTURE_NEAREST } else { 0 };
+        texture.transform_u = sampling.transform[0];
+        texture.transform_v = sampling.transform[1];
+        self.push(texture)
     }
 
     fn push(&mut self, texture: Texture) -> u32 {

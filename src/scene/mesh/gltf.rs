@@ -17,12 +17,15 @@ use super::{
     Geometry, ImageSource, MeshFile, MeshPart, MAX_TRIANGLES,
 };
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
+use crate::scene::texture::Sampling;
 use crate::scene::{Material, MaterialKind};
+use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use base64::Engine as _;
 use glam::{Mat4, Quat, Vec2, Vec3};
 use gltf::json;
 use json::accessor::{ComponentType, Type};
 use json::mesh::{Mode, Semantic};
+use json::texture::{MagFilter, WrappingMode};
 use json::validation::Checked;
 use std::collections::hash_map::{Entry, HashMap};
 use std::path::{Path, PathBuf};
@@ -35,10 +38,11 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
     "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
 ];
 
 /// Extensions glint reads entirely; any other the file uses gets a warning.
-const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization"];
+const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization", "KHR_texture_transform"];
 
 /// Decoded vertex data may reach this many bytes per byte of the file's buffers (plus
 /// [`DECODE_SLACK`]): a byte index becomes a u32, a byte normal component an f32. It bounds
@@ -78,14 +82,14 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     let mut images: Vec<Option<Rc<ImageSource>>> = vec![None; root.images.len()];
     for (i, m) in root.materials.iter().enumerate() {
         let (material, maps, other_textures) = material(&root, m, i, &mut warnings)?;
-        let mut source = |image: Option<usize>| -> Result<_, String> {
-            let Some(i) = image else {
+        let mut source = |image: Option<(usize, Sampling)>| -> Result<_, String> {
+            let Some((i, sampling)) = image else {
                 return Ok(None);
             };
             if images[i].is_none() {
                 images[i] = Some(Rc::new(image_source(&root, &buffers, i, dir)?));
             }
-            Ok(images[i].clone())
+            Ok(images[i].clone().map(|image| (image, sampling)))
         };
         textures.push(FileTextures {
             color: source(maps.color)?,
@@ -567,14 +571,62 @@ fn material(
         let field = format!("materials[{index}].{field}");
         let t = exists(info.index.value(), root.textures.len(), "texture")
             .map_err(|e| format!("{field}.index: {e}"))?;
-        if info.tex_coord != 0 {
+        let transform = info
+            .extensions
+            .as_ref()
+            .and_then(|e| e.texture_transform.as_ref());
+        // KHR_texture_transform's texCoord overrides the reference's.
+        let tex_coord = transform
+            .and_then(|t| t.tex_coord)
+            .unwrap_or(info.tex_coord);
+        if tex_coord != 0 {
             warnings.push(format!(
-                "{field}: on TEXCOORD_{}; glint reads TEXCOORD_0 only, so the texture is ignored",
-                info.tex_coord
+                "{field}: on TEXCOORD_{tex_coord}; glint reads TEXCOORD_0 only, so the texture is \
+                 ignored"
             ));
             return Ok(None);
         }
-        Ok::<_, String>(Some(root.textures[t].source.value()))
+        let mut sampling = Sampling::default();
+        if let Some(s) = root.textures[t].sampler {
+            let s = exists(s.value(), root.samplers.len(), "sampler")
+                .map_err(|e| format!("textures[{t}].sampler: {e}"))?;
+            let sampler = &root.samplers[s];
+            for (axis, (mode, name)) in [(sampler.wrap_s, "wrapS"), (sampler.wrap_t, "wrapT")]
+                .into_iter()
+                .enumerate()
+            {
+                sampling.wrap[axis] = match mode {
+                    Checked::Valid(WrappingMode::Repeat) => TEXTURE_WRAP_REPEAT,
+                    Checked::Valid(WrappingMode::ClampToEdge) => TEXTURE_WRAP_CLAMP,
+                    Checked::Valid(WrappingMode::MirroredRepeat) => TEXTURE_WRAP_MIRROR,
+                    Checked::Invalid => {
+                        return Err(format!("samplers[{s}].{name}: not a glTF wrap mode"))
+                    }
+                };
+            }
+            // Without mipmaps, the magnification filter decides.
+            sampling.nearest = sampler.mag_filter == Some(Checked::Valid(MagFilter::Nearest));
+        }
+        if let Some(t) = transform {
+            let [ox, oy] = t.offset.0;
+            let [sx, sy] = t.scale.0;
+            let (sin, cos) = t.rotation.0.sin_cos();
+            // glTF's uv' = T R S uv, R rotating the UVs counterclockwise as the extension's text
+            // says, drawn with glTF's v down: u' = cos sx u + sin sy v + ox, v' = −sin sx u +
+            // cos sy v + oy. (The GLSL snippet in the extension's README has the opposite sign;
+            // Khronos' TextureTransformTest, whose markers say which way is right, and three.js
+            // follow the text.) Here in glint's coordinates, whose v is 1 − glTF's.
+            sampling.transform = [
+                [cos * sx, -sin * sy, ox + sin * sy],
+                [sin * sx, cos * sy, 1.0 - cos * sy - oy],
+            ];
+            if !sampling.transform.iter().flatten().all(|c| c.is_finite()) {
+                return Err(format!(
+                    "{field}.extensions.KHR_texture_transform: not finite"
+                ));
+            }
+        }
+        Ok::<_, String>(Some((root.textures[t].source.value(), sampling)))
     };
     let maps = MaterialImages {
         color: image(
@@ -604,10 +656,10 @@ fn material(
     ))
 }
 
-/// The images (indices into `images`) of a material's texture maps.
+/// The images (indices into `images`) of a material's texture maps, and how each is sampled.
 struct MaterialImages {
-    color: Option<usize>,
-    metallic_roughness: Option<usize>,
+    color: Option<(usize, Sampling)>,
+    metallic_roughness: Option<(usize, Sampling)>,
 }
 
 /// Where image `i` comes from: a file its URI names, or bytes in the glTF file (a buffer view

@@ -11,7 +11,7 @@ mod obj;
 mod ply;
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
-use super::texture::{TextureSet, TextureUse};
+use super::texture::{Sampling, TextureSet, TextureUse};
 use super::{Material, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec2, Vec3};
@@ -103,10 +103,10 @@ pub(super) enum ImageSource {
 pub(super) struct FileTextures {
     /// Multiplies the material's colour (OBJ `map_Kd`, whose colour is then 1; glTF
     /// `baseColorTexture`).
-    color: Option<Rc<ImageSource>>,
+    color: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `metallicRoughnessTexture`: green multiplies the roughness, blue the metallic
     /// factor.
-    metallic_roughness: Option<Rc<ImageSource>>,
+    metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -211,10 +211,13 @@ pub(super) fn load(
                         let mut m = file.materials[index].clone();
                         let maps = &file.textures[index];
                         let name = m.name.clone();
-                        let mut load = |source: &Option<Rc<ImageSource>>, usage| {
-                            source
-                                .as_deref()
-                                .map(|source| texture(source, usage, path, shown, &name, textures))
+                        let mut load = |map: &Option<(Rc<ImageSource>, Sampling)>, usage| {
+                            map.as_ref()
+                                .map(|(source, sampling)| {
+                                    let image =
+                                        texture(source, usage, path, shown, &name, textures)?;
+                                    Ok::<_, String>(textures.sampled(image, sampling))
+                                })
                                 .transpose()
                         };
                         m.color_texture = load(&maps.color, TextureUse::Color)?;

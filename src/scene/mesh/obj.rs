@@ -128,7 +128,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
             material.color = Vec3::ONE;
         }
         file_textures.push(FileTextures {
-            color: map_kd.map(|path| Rc::new(ImageSource::File(path))),
+            color: map_kd.map(|path| (Rc::new(ImageSource::File(path)), Default::default())),
             ..Default::default()
         });
         converted.push(material);
