@@ -151,6 +151,16 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
             out.alpha = m.alpha * (t.x * t.x);
             out.metallic = m.metallic * t.y;
         }
+        out.emission = emission_at(m, uv);
     }
     return out;
+}
+
+// The radiance material m emits at texture coordinates uv: its emission times its emission
+// texture there (sRGB-decoded), if it has one. Light sampling calls it at the point it samples.
+fn emission_at(m: Material, uv: vec2<f32>) -> vec3<f32> {
+    if HAS_TEXTURES && m.emission_texture != NO_TEXTURE {
+        return m.emission * texture_lookup(m.emission_texture, uv);
+    }
+    return m.emission;
 }

@@ -99,6 +99,8 @@ struct Material {
     // PBR: KHR_materials_specular's colour and factor for the dielectric layer.
     specular_color: vec3<f32>,
     specular: f32,
+    // Texture multiplying emission at the hit (glTF's emissiveTexture), or NO_TEXTURE.
+    emission_texture: u32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;

@@ -116,6 +116,9 @@ pub struct Material {
     /// PBR: KHR_materials_specular's colour and factor for the dielectric layer.
     pub specular_color: [f32; 3],
     pub specular: f32,
+    /// Texture multiplying `emission` at the hit (glTF's emissiveTexture), or [`NO_TEXTURE`].
+    pub emission_texture: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `Material::color_texture` and `roughness_texture` when the value is constant.

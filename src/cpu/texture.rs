@@ -179,5 +179,16 @@ pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
         out.alpha = m.alpha * (t.x * t.x);
         out.metallic = m.metallic * t.y;
     }
+    out.emission = emission_at(textures, m, uv).into();
     out
+}
+
+/// The radiance material `m` emits at texture coordinates `uv`: its emission times its
+/// emission texture there (sRGB-decoded), if it has one. Light sampling calls it at the point
+/// it samples.
+pub fn emission_at(textures: &Textures, m: &Material, uv: Vec2) -> Vec3 {
+    if m.emission_texture != NO_TEXTURE {
+        return Vec3::from(m.emission) * texture_lookup(textures, m.emission_texture, uv);
+    }
+    Vec3::from(m.emission)
 }

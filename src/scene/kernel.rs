@@ -2,6 +2,7 @@
 //! that light sampling draws from.
 
 use super::bvh;
+use super::emitter_power::EmissionMeans;
 use super::environment;
 use super::light::LightKind;
 use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
@@ -12,7 +13,7 @@ use crate::shader_types::{
     MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
     PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
 #[derive(Clone, Debug)]
@@ -127,6 +128,7 @@ impl Scene {
                 emitted_radiance: radiance,
                 color_texture: None,
                 roughness_texture: None,
+                emission_texture: None,
             });
         }
         scene
@@ -247,6 +249,8 @@ impl Scene {
                     metallic,
                     specular_color: specular_color.into(),
                     specular,
+                    emission_texture: m.emission_texture.unwrap_or(NO_TEXTURE),
+                    _pad: [0; 3],
                 }
             })
             .collect();
@@ -359,11 +363,19 @@ impl Scene {
                 powers.push((PRIMITIVE_QUAD, i as u32, power));
             }
         }
+        let mut textured = EmissionMeans::new(&self.textures);
         for (i, t) in self.triangles.iter().enumerate() {
             let [a, b, c] = t.vertices;
-            let power = radiance(t.material).element_sum() as f64 / 3.0
-                * 0.5
-                * (b - a).cross(c - a).length() as f64;
+            let m = &self.materials[t.material as usize];
+            let mean = match m.emission_texture {
+                Some(texture) if m.emitted_radiance != Vec3::ZERO => textured.triangle_mean(
+                    m.emitted_radiance,
+                    texture,
+                    t.uvs.unwrap_or([Vec2::ZERO; 3]),
+                ),
+                _ => radiance(t.material).element_sum() as f64 / 3.0,
+            };
+            let power = mean * 0.5 * (b - a).cross(c - a).length() as f64;
             if power > 0.0 {
                 powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }

@@ -8,6 +8,7 @@
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
 pub mod bvh;
+mod emitter_power;
 pub mod environment;
 mod file;
 pub mod image;
@@ -180,6 +181,10 @@ pub struct Material {
     /// Index into [`Scene::textures`] whose first channel multiplies the roughness (1 for TOML
     /// textures) and whose second multiplies a pbr material's `metallic`.
     pub roughness_texture: Option<u32>,
+    /// Index into [`Scene::textures`] multiplying `emitted_radiance` at each point (glTF's
+    /// emissiveTexture; light sampling weighs each triangle by the texture's mean over it,
+    /// `src/scene/emitter_power.rs`).
+    pub emission_texture: Option<u32>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

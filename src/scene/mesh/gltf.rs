@@ -94,6 +94,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
         textures.push(FileTextures {
             color: source(maps.color)?,
             metallic_roughness: source(maps.metallic_roughness)?,
+            emission: source(maps.emission)?,
         });
         materials.push(material);
         has_other_textures |= other_textures;
@@ -555,15 +556,6 @@ fn material(
     // Occlusion maps are for rasterisers (a path tracer finds the occlusion), so they are
     // ignored without a word.
     let mut other_textures = m.normal_texture.is_some();
-    let mut emission = emission;
-    if m.emissive_texture.is_some() && emission != Vec3::ZERO {
-        warnings.push(format!(
-            "materials[{index}]: emissiveTexture is not read, so the material's emission \
-             (emissiveFactor {}) is left out rather than spread evenly over the surface",
-            Vec3::from(m.emissive_factor.0)
-        ));
-        emission = Vec3::ZERO;
-    }
     let mut image = |info: &Option<json::texture::Info>, field: &str| {
         let Some(info) = info else {
             return Ok(None);
@@ -637,6 +629,12 @@ fn material(
             &pbr.metallic_roughness_texture,
             "pbrMetallicRoughness.metallicRoughnessTexture",
         )?,
+        // Without emission the texture multiplies nothing.
+        emission: if emission == Vec3::ZERO {
+            None
+        } else {
+            image(&m.emissive_texture, "emissiveTexture")?
+        },
     };
     if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
         other_textures |=
@@ -650,6 +648,7 @@ fn material(
             emitted_radiance: emission,
             color_texture: None,
             roughness_texture: None,
+            emission_texture: None,
         },
         maps,
         other_textures,
@@ -660,6 +659,7 @@ fn material(
 struct MaterialImages {
     color: Option<(usize, Sampling)>,
     metallic_roughness: Option<(usize, Sampling)>,
+    emission: Option<(usize, Sampling)>,
 }
 
 /// Where image `i` comes from: a file its URI names, or bytes in the glTF file (a buffer view

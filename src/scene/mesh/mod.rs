@@ -107,6 +107,8 @@ pub(super) struct FileTextures {
     /// glTF's `metallicRoughnessTexture`: green multiplies the roughness, blue the metallic
     /// factor.
     metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
+    /// glTF's `emissiveTexture` (sRGB), multiplying the emission.
+    emission: Option<(Rc<ImageSource>, Sampling)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -157,8 +159,8 @@ pub(super) fn load(
         .collect();
     if file.has_other_textures {
         warnings.push(format!(
-            "{shown}: texture maps other than the base colour and metallic-roughness (normal, \
-             emission, ...) are ignored"
+            "{shown}: texture maps other than the base colour, metallic-roughness and emission \
+             (normal, specular, ...) are ignored"
         ));
     }
     // The file's materials become scene materials, but only when they are used.
@@ -223,6 +225,7 @@ pub(super) fn load(
                         m.color_texture = load(&maps.color, TextureUse::Color)?;
                         m.roughness_texture =
                             load(&maps.metallic_roughness, TextureUse::MetallicRoughness)?;
+                        m.emission_texture = load(&maps.emission, TextureUse::Color)?;
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;
                         scene_materials.push(m);

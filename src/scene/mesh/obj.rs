@@ -85,6 +85,7 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
             emitted_radiance: emission,
             color_texture: None,
             roughness_texture: None,
+            emission_texture: None,
         },
         textures,
     ))

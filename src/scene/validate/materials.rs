@@ -296,6 +296,7 @@ pub(super) fn validate_materials(
             emitted_radiance: emission * strength,
             color_texture,
             roughness_texture,
+            emission_texture: None,
         });
     }
     Ok(Materials {
