@@ -101,6 +101,10 @@ struct Material {
     specular: f32,
     // Texture multiplying emission at the hit (glTF's emissiveTexture), or NO_TEXTURE.
     emission_texture: u32,
+    // Tangent-space normal map (glTF's normalTexture), or NO_TEXTURE; its x and y are scaled by
+    // normal_scale (normal_map.wgsl).
+    normal_texture: u32,
+    normal_scale: f32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;
@@ -128,6 +132,14 @@ struct TriangleNormals {
     smooth_shading: u32,
     n1: vec3<f32>,
     n2: vec3<f32>,
+}
+
+// A triangle's vertex tangents for normal mapping: xyz the unit tangent along increasing u, w
+// the bitangent's sign (bitangent = w * cross(normal, tangent), along increasing v).
+struct TriangleTangents {
+    t0: vec4<f32>,
+    t1: vec4<f32>,
+    t2: vec4<f32>,
 }
 
 // A node of the flattened BVH (src/scene/bvh.rs). An inner node (count == 0) has its children at

@@ -118,7 +118,11 @@ pub struct Material {
     pub specular: f32,
     /// Texture multiplying `emission` at the hit (glTF's emissiveTexture), or [`NO_TEXTURE`].
     pub emission_texture: u32,
-    pub _pad: [u32; 3],
+    /// Tangent-space normal map (glTF's normalTexture), or [`NO_TEXTURE`]; its x and y are
+    /// scaled by `normal_scale` (`src/cpu/normal_map.rs`).
+    pub normal_texture: u32,
+    pub normal_scale: f32,
+    pub _pad: u32,
 }
 
 /// `Material::color_texture` and `roughness_texture` when the value is constant.
@@ -172,6 +176,17 @@ pub struct TriangleNormals {
     pub _pad1: u32,
     pub n2: [f32; 3],
     pub _pad2: u32,
+}
+
+/// A triangle's vertex tangents for normal mapping (glTF's TANGENT, or MikkTSpace's): xyz the
+/// unit tangent along increasing u, w the bitangent's sign (bitangent = w · normal × tangent,
+/// along increasing v, glint's v being up). One per triangle when a material has a normal map.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TriangleTangents {
+    pub t0: [f32; 4],
+    pub t1: [f32; 4],
+    pub t2: [f32; 4],
 }
 
 /// A node of the flattened BVH. An inner node (`count == 0`) has its children at `first` and

@@ -54,6 +54,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             color_texture: None,
             roughness_texture: None,
             emission_texture: None,
+            normal_texture: None,
         }],
         spheres: vec![],
         quads: vec![SceneQuad {

@@ -7,7 +7,7 @@ use glint::shader::{
 };
 use glint::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleNormals, TriangleUvs,
+    Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs,
 };
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
@@ -154,7 +154,9 @@ fn rust_structs_match_wgsl_layout() {
             metallic,
             specular_color,
             specular,
-            emission_texture
+            emission_texture,
+            normal_texture,
+            normal_scale
         ]
     );
     assert_same_layout!(
@@ -219,8 +221,9 @@ fn rust_structs_match_wgsl_layout() {
         ]
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
-    // Five vec4s: glTF's emissive texture took the fifth (a uniform-bound scene's materials
-    // stay far below the uniform limit).
+    assert_same_layout!(&module, TriangleTangents, "TriangleTangents", [t0, t1, t2]);
+    // Five vec4s: glTF's emissive and normal textures took the fifth (a uniform-bound
+    // scene's materials stay far below the uniform limit).
     assert_eq!(size_of::<Material>(), 80, "Material stays 80 bytes");
     assert_same_layout!(
         &module,

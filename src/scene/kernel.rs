@@ -9,9 +9,9 @@ use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR,
-    MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    TriangleTangents, TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL,
+    MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT,
+    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::{Vec2, Vec3};
 
@@ -36,6 +36,8 @@ pub struct KernelScene {
     pub texels: Vec<[f32; 4]>,
     /// One per triangle when the scene has textures, else empty.
     pub triangle_uvs: Vec<TriangleUvs>,
+    /// One per triangle when a material has a normal map, else empty.
+    pub triangle_tangents: Vec<TriangleTangents>,
     /// The environment map's texels and alias table (`environment.rs`); empty without one.
     pub environment_texels: Vec<EnvironmentTexel>,
     pub environment_alias: Vec<EnvironmentAlias>,
@@ -61,6 +63,7 @@ impl KernelScene {
             + bytes(&self.textures)
             + bytes(&self.texels)
             + bytes(&self.triangle_uvs)
+            + bytes(&self.triangle_tangents)
             + bytes(&self.environment_texels)
             + bytes(&self.environment_alias)
             + bytes(&self.lights)
@@ -129,6 +132,7 @@ impl Scene {
                 color_texture: None,
                 roughness_texture: None,
                 emission_texture: None,
+                normal_texture: None,
             });
         }
         scene
@@ -250,7 +254,9 @@ impl Scene {
                     specular_color: specular_color.into(),
                     specular,
                     emission_texture: m.emission_texture.unwrap_or(NO_TEXTURE),
-                    _pad: [0; 3],
+                    normal_texture: m.normal_texture.map_or(NO_TEXTURE, |(t, _)| t),
+                    normal_scale: m.normal_texture.map_or(1.0, |(_, s)| s),
+                    _pad: 0,
                 }
             })
             .collect();
@@ -307,6 +313,17 @@ impl Scene {
                         TriangleUvs { uv0, uv1, uv2 }
                     })
                     .collect()
+            },
+            triangle_tangents: if self.materials.iter().any(|m| m.normal_texture.is_some()) {
+                self.triangles
+                    .iter()
+                    .map(|t| {
+                        let [t0, t1, t2] = t.tangents.unwrap_or_default().map(|t| t.into());
+                        TriangleTangents { t0, t1, t2 }
+                    })
+                    .collect()
+            } else {
+                Vec::new()
             },
             environment_texels: Vec::new(),
             environment_alias: Vec::new(),

@@ -24,7 +24,7 @@ pub use kernel::{place_camera, KernelScene};
 
 use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -94,6 +94,8 @@ pub struct Triangle {
     pub material: u32,
     /// Texture coordinates at the vertices (v up), where the file gives them.
     pub uvs: Option<[Vec2; 3]>,
+    /// Vertex tangents (xyz unit, w the bitangent's sign) where the material has a normal map.
+    pub tangents: Option<[Vec4; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -185,6 +187,9 @@ pub struct Material {
     /// emissiveTexture; light sampling weighs each triangle by the texture's mean over it,
     /// `src/scene/emitter_power.rs`).
     pub emission_texture: Option<u32>,
+    /// Index into [`Scene::textures`] of a tangent-space normal map (glTF's normalTexture),
+    /// and the scale of its x and y.
+    pub normal_texture: Option<(u32, f32)>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

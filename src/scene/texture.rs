@@ -45,6 +45,8 @@ pub enum TextureUse {
     /// glTF's metallicRoughnessTexture: linear, roughness in green and metallic in blue, both
     /// in [0, 1].
     MetallicRoughness,
+    /// A tangent-space normal map (glTF's normalTexture): linear, every channel in [0, 1].
+    Normal,
 }
 
 /// Every texture of a scene, as the kernel reads them.
@@ -116,7 +118,7 @@ impl TextureSet {
         }
         // The channels the use reads.
         let channels = match usage {
-            TextureUse::Color => 0..3,
+            TextureUse::Color | TextureUse::Normal => 0..3,
             TextureUse::Roughness => 0..1,
             TextureUse::MetallicRoughness => 1..3,
         };
@@ -136,6 +138,7 @@ impl TextureSet {
                             TextureUse::Color => "color",
                             TextureUse::Roughness => "roughness",
                             TextureUse::MetallicRoughness => "metallic-roughness",
+                            TextureUse::Normal => "normal",
                         }
                     ));
                 }
@@ -155,7 +158,7 @@ impl TextureSet {
                 // Roughness textures as the kernel reads them: x the roughness, y the
                 // metallic factor (1 where the texture gives none).
                 self.texels.push(match usage {
-                    TextureUse::Color => [r, g, b, 0.0],
+                    TextureUse::Color | TextureUse::Normal => [r, g, b, 0.0],
                     TextureUse::Roughness => [r, 1.0, 1.0, 0.0],
                     TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
                 });
@@ -208,6 +211,8 @@ impl TextureSet {
 fn encoding(usage: TextureUse) -> Encoding {
     match usage {
         TextureUse::Color => Encoding::Srgb,
-        TextureUse::Roughness | TextureUse::MetallicRoughness => Encoding::Linear,
+        TextureUse::Roughness | TextureUse::MetallicRoughness | TextureUse::Normal => {
+            Encoding::Linear
+        }
     }
 }

@@ -21,7 +21,7 @@ use crate::scene::texture::Sampling;
 use crate::scene::{Material, MaterialKind};
 use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use base64::Engine as _;
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::json;
 use json::accessor::{ComponentType, Type};
 use json::mesh::{Mode, Semantic};
@@ -42,7 +42,11 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
 ];
 
 /// Extensions glint reads entirely; any other the file uses gets a warning.
-const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization", "KHR_texture_transform"];
+const FULLY_READ_EXTENSIONS: &[&str] = &[
+    "KHR_materials_emissive_strength",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+];
 
 /// Decoded vertex data may reach this many bytes per byte of the file's buffers (plus
 /// [`DECODE_SLACK`]): a byte index becomes a u32, a byte normal component an f32. It bounds
@@ -95,6 +99,10 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
             color: source(maps.color)?,
             metallic_roughness: source(maps.metallic_roughness)?,
             emission: source(maps.emission)?,
+            normal: match maps.normal {
+                Some((image, scale)) => source(Some(image))?.map(|s| (s, scale)),
+                None => None,
+            },
         });
         materials.push(material);
         has_other_textures |= other_textures;
@@ -555,7 +563,7 @@ fn material(
     )?;
     // Occlusion maps are for rasterisers (a path tracer finds the occlusion), so they are
     // ignored without a word.
-    let mut other_textures = m.normal_texture.is_some();
+    let mut other_textures = false;
     let mut image = |info: &Option<json::texture::Info>, field: &str| {
         let Some(info) = info else {
             return Ok(None);
@@ -635,6 +643,35 @@ fn material(
         } else {
             image(&m.emissive_texture, "emissiveTexture")?
         },
+        normal: match &m.normal_texture {
+            Some(n) => {
+                let field = format!("materials[{index}].normalTexture");
+                if !n.scale.is_finite() {
+                    return Err(format!("{field}.scale: not finite"));
+                }
+                // The crate keeps a normal texture's extensions unparsed.
+                let transform = n
+                    .extensions
+                    .as_ref()
+                    .and_then(|e| e.others.get("KHR_texture_transform"))
+                    .map(|v| {
+                        serde_json::from_value(v.clone())
+                            .map_err(|e| format!("{field}.extensions.KHR_texture_transform: {e}"))
+                    })
+                    .transpose()?;
+                let info = json::texture::Info {
+                    index: n.index,
+                    tex_coord: n.tex_coord,
+                    extensions: Some(json::extensions::texture::Info {
+                        texture_transform: transform,
+                        others: Default::default(),
+                    }),
+                    extras: Default::default(),
+                };
+                image(&Some(info), "normalTexture")?.map(|i| (i, n.scale))
+            }
+            None => None,
+        },
     };
     if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
         other_textures |=
@@ -649,6 +686,7 @@ fn material(
             color_texture: None,
             roughness_texture: None,
             emission_texture: None,
+            normal_texture: None,
         },
         maps,
         other_textures,
@@ -660,6 +698,8 @@ struct MaterialImages {
     color: Option<(usize, Sampling)>,
     metallic_roughness: Option<(usize, Sampling)>,
     emission: Option<(usize, Sampling)>,
+    /// The normal map and its scale.
+    normal: Option<((usize, Sampling), f32)>,
 }
 
 /// Where image `i` comes from: a file its URI names, or bytes in the glTF file (a buffer view
@@ -707,6 +747,7 @@ struct PrimitivePlan {
     positions: usize,
     normals: Option<usize>,
     uvs: Option<usize>,
+    tangents: Option<usize>,
     indices: Option<usize>,
     material: Option<usize>,
     triangles: u64,
@@ -743,7 +784,12 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             .ok_or_else(|| format!("{name}.attributes: no POSITION"))?;
         let normals = attribute(Semantic::Normals, "NORMAL", Type::Vec3)?;
         let uvs = attribute(Semantic::TexCoords(0), "TEXCOORD_0", Type::Vec2)?;
-        for (label, other) in [("NORMAL", normals), ("TEXCOORD_0", uvs)] {
+        let tangents = attribute(Semantic::Tangents, "TANGENT", Type::Vec4)?;
+        for (label, other) in [
+            ("NORMAL", normals),
+            ("TEXCOORD_0", uvs),
+            ("TANGENT", tangents),
+        ] {
             if let Some((a, count)) = other {
                 if count != vertices {
                     return Err(format!(
@@ -772,6 +818,7 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             positions,
             normals: normals.map(|(a, _)| a),
             uvs: uvs.map(|(a, _)| a),
+            tangents: tangents.map(|(a, _)| a),
             indices: indices.map(|(a, _)| a),
             material,
             triangles: indices.map_or(vertices, |(_, count)| count) as u64 / 3,
@@ -1152,6 +1199,18 @@ impl Decoder<'_> {
                 .collect(),
             None => Vec::new(),
         };
+        // glTF's tangents point along increasing u, and their w (±1) makes the bitangent
+        // w · normal × tangent point along increasing v of glTF's v-up normal-map convention,
+        // which is glint's v: both are kept as they are.
+        let tangents = match plan.tangents {
+            Some(a) => self
+                .layout(a, Type::Vec4, false)?
+                .floats::<4>()?
+                .into_iter()
+                .map(Vec4::from)
+                .collect(),
+            None => Vec::new(),
+        };
         let flat: Vec<u32> = match plan.indices {
             Some(a) => self.layout(a, Type::Scalar, true)?.indices()?,
             None => (0..positions.len() as u32).collect(),
@@ -1160,6 +1219,7 @@ impl Decoder<'_> {
             positions,
             normals,
             uvs,
+            tangents,
             indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         })
     }

@@ -9,12 +9,13 @@
 mod gltf;
 mod obj;
 mod ply;
+mod tangents;
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{Sampling, TextureSet, TextureUse};
 use super::{Material, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -48,6 +49,9 @@ pub(super) struct Geometry {
     normals: Vec<Vec3>,
     /// Texture coordinates (v up), as many as positions, or none.
     uvs: Vec<Vec2>,
+    /// glTF's TANGENT (xyz along increasing u, w the bitangent's sign), as many as positions,
+    /// or none.
+    tangents: Vec<Vec4>,
     indices: Vec<[u32; 3]>,
 }
 
@@ -109,6 +113,8 @@ pub(super) struct FileTextures {
     metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `emissiveTexture` (sRGB), multiplying the emission.
     emission: Option<(Rc<ImageSource>, Sampling)>,
+    /// glTF's `normalTexture` (linear), and its scale.
+    normal: Option<((Rc<ImageSource>, Sampling), f32)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -159,8 +165,8 @@ pub(super) fn load(
         .collect();
     if file.has_other_textures {
         warnings.push(format!(
-            "{shown}: texture maps other than the base colour, metallic-roughness and emission \
-             (normal, specular, ...) are ignored"
+            "{shown}: texture maps other than the base colour, metallic-roughness, emission and \
+             normal maps (KHR_materials_specular's) are ignored"
         ));
     }
     // The file's materials become scene materials, but only when they are used.
@@ -173,6 +179,8 @@ pub(super) fn load(
     let mut triangles = Vec::new();
     let mut degenerate = 0usize;
     let mut checked = std::collections::HashSet::new();
+    let mut tangent_cache: std::collections::HashMap<*const Geometry, Rc<Vec<[Vec4; 3]>>> =
+        std::collections::HashMap::new();
     for part in &file.parts {
         let matrix = scene_matrix * part.transform;
         // Normals go through the inverse transpose of the linear part.
@@ -226,6 +234,10 @@ pub(super) fn load(
                         m.roughness_texture =
                             load(&maps.metallic_roughness, TextureUse::MetallicRoughness)?;
                         m.emission_texture = load(&maps.emission, TextureUse::Color)?;
+                        if let Some((map, scale)) = &maps.normal {
+                            m.normal_texture =
+                                load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
+                        }
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;
                         scene_materials.push(m);
@@ -236,6 +248,30 @@ pub(super) fn load(
             }
         };
         let count = geometry.positions.len();
+        // Normal maps need tangents at every corner (tangents.rs), read or made once per
+        // geometry.
+        let corners = if scene_materials[material as usize].normal_texture.is_some() {
+            if geometry.uvs.len() != count {
+                return Err(format!(
+                    "{shown}: {}material {:?} has a normal map, but these triangles have no \
+                     texture coordinates (TEXCOORD_0) to lay it out",
+                    part_prefix(&part.name),
+                    scene_materials[material as usize].name
+                ));
+            }
+            let key = Rc::as_ptr(&part.geometry);
+            Some(
+                tangent_cache
+                    .entry(key)
+                    .or_insert_with(|| {
+                        Rc::new(tangents::corner_tangents(geometry).unwrap_or_default())
+                    })
+                    .clone(),
+            )
+        } else {
+            None
+        };
+        let linear = Mat3::from_mat4(matrix);
         for (f, idx) in geometry.indices.iter().enumerate() {
             if let Some(&bad) = idx.iter().find(|&&i| i as usize >= count) {
                 return Err(format!(
@@ -263,11 +299,16 @@ pub(super) fn load(
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
             let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+            let tangents = corners
+                .as_ref()
+                .and_then(|c| c.get(f))
+                .map(|c| c.map(|t| tangents::placed_tangent(&linear, t)));
             triangles.push(Triangle {
                 vertices: v,
                 normals,
                 material,
                 uvs,
+                tangents,
             });
             if triangles.len() > MAX_TRIANGLES {
                 return Err(format!(

@@ -86,6 +86,7 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
             color_texture: None,
             roughness_texture: None,
             emission_texture: None,
+            normal_texture: None,
         },
         textures,
     ))
@@ -147,6 +148,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
                         .chunks_exact(2)
                         .map(Vec2::from_slice)
                         .collect(),
+                    tangents: Vec::new(),
                     indices: mesh
                         .indices
                         .chunks_exact(3)

@@ -92,6 +92,7 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
                 positions,
                 normals,
                 uvs: Vec::new(),
+                tangents: Vec::new(),
                 indices,
             },
             None,

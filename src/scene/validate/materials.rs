@@ -297,6 +297,7 @@ pub(super) fn validate_materials(
             color_texture,
             roughness_texture,
             emission_texture: None,
+            normal_texture: None,
         });
     }
     Ok(Materials {
