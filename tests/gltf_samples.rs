@@ -222,3 +222,117 @@ fn the_texture_transform_test_shows_what_it_should() {
         );
     }
 }
+
+/// The folder of real test assets made by others (`GLINT_ASSETS`, which `.ci/run` sets to
+/// `../shared/assets`), or None (with a line on stderr) where it is not set.
+fn asset(name: &str) -> Option<PathBuf> {
+    let Some(dir) = std::env::var_os("GLINT_ASSETS") else {
+        eprintln!("GLINT_ASSETS is not set: {name} skipped");
+        return None;
+    };
+    let path = Path::new(&dir).join(name);
+    if path.exists() {
+        Some(path)
+    } else {
+        eprintln!("{} is absent: skipped", path.display());
+        None
+    }
+}
+
+/// The helmet seen from the front (the glTF's +z), `size`² pixels, with `lighting` (TOML
+/// lines) and `material` (a `[[meshes]]` line, or none for the file's own materials).
+fn render_helmet(helmet: &Path, size: u32, spp: u32, lighting: &str, material: &str) -> Image {
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        r#"[camera]
+eye = [0.0, 0.0, 3.2]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+[render]
+width = {size}
+height = {size}
+spp = {spp}
+{lighting}
+{material}
+[[meshes]]
+file = "{}"
+{}
+"#,
+        helmet.display(),
+        if material.is_empty() {
+            ""
+        } else {
+            "material = \"white\""
+        }
+    );
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    common::render_cpu(&scene.kernel_scene(), spp)
+}
+
+/// Khronos' DamagedHelmet.glb as its author made it (embedded JPEG maps, emissiveFactor
+/// [1, 1, 1] with an emissive texture). It used to render as a uniformly glowing white
+/// silhouette. Now:
+/// - in the dark (black background, no bounces: the camera sees emission only), the glowing
+///   pixels are the emissive map's lamps and visor, a small part of the helmet: between 0.2%
+///   and 10% of the image (the helmet covers about half of it), while at least one of them
+///   glows brighter than 0.5;
+/// - under the environment map, the helmet is not white: the mean of the image's central
+///   square is under 70% of the same helmet's with a white diffuse material.
+#[test]
+fn the_damaged_helmet_glows_only_where_its_emissive_map_says() {
+    let (Some(helmet), Some(sky)) = (asset("DamagedHelmet.glb"), asset("royal_esplanade_1k.hdr"))
+    else {
+        return;
+    };
+    let dark = render_helmet(
+        &helmet,
+        64,
+        4,
+        "max_bounces = 0\nbackground = [0.0, 0.0, 0.0]",
+        "",
+    );
+    let glowing = dark
+        .pixels
+        .iter()
+        .filter(|p| p.iter().any(|c| *c > 0.05))
+        .count() as f64
+        / dark.pixels.len() as f64;
+    let brightest = dark.pixels.iter().flatten().fold(0.0f32, |m, c| m.max(*c));
+    eprintln!("glowing fraction {glowing:.4}, brightest {brightest}");
+    assert!(
+        (0.002..0.1).contains(&glowing) && brightest > 0.5,
+        "{:.2}% of the pixels glow, the brightest at {brightest}",
+        100.0 * glowing
+    );
+    let lit = format!(
+        "max_bounces = 4\n[environment]\nfile = \"{}\"",
+        sky.display()
+    );
+    let centre_mean = |image: &Image| {
+        let (n, mut sum) = (image.width, 0.0);
+        let mut count = 0;
+        for y in n / 4..3 * n / 4 {
+            for x in n / 4..3 * n / 4 {
+                sum += Vec3::from(image.pixels[(y * n + x) as usize]).element_sum() / 3.0;
+                count += 1;
+            }
+        }
+        sum / count as f32
+    };
+    let authored = centre_mean(&render_helmet(&helmet, 48, 16, &lit, ""));
+    let white = centre_mean(&render_helmet(
+        &helmet,
+        48,
+        16,
+        &lit,
+        "[materials.white]\ntype = \"diffuse\"\ncolor = [1.0, 1.0, 1.0]",
+    ));
+    eprintln!("centre mean {authored} against {white} for a white helmet");
+    assert!(
+        authored < 0.7 * white,
+        "the helmet's centre averages {authored}, a white one's {white}"
+    );
+}
