@@ -5,7 +5,7 @@
 // direction as interpolated normals are (shading_normal.wgsl).
 
 // One per triangle when a material has a normal map (a placeholder otherwise).
-@group(0) @binding(26) var<storage, read> triangle_tangents: array<TriangleTangents>;
+@group(0) @binding(28) var<storage, read> triangle_tangents: array<TriangleTangents>;
 
 // The least cosine a mapped normal keeps with the geometric normal before validation.
 const NORMAL_MAP_MIN_COS: f32 = 1e-3;
