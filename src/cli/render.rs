@@ -6,7 +6,7 @@ use super::render_writer::RenderWriter;
 use super::sample_range::{self, SampleRangeArgs};
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
-use crate::gpu::{GpuContext, GpuRenderer};
+use crate::gpu::{GpuContext, GpuRenderer, TraversalChoice};
 use crate::interrupt::{self, Interrupted};
 use crate::output::ImageFormat;
 use crate::output_check::OutputSet;
@@ -60,6 +60,11 @@ pub struct RenderArgs {
     /// Render on a Vulkan GPU or fail; without it, no GPU means a CPU render.
     #[arg(long)]
     pub gpu: bool,
+    /// How the GPU kernel finds hits: the device's ray queries (hardware), glint's own BVH
+    /// (software), or auto: hardware where the device has ray queries, but not on lavapipe
+    /// (no faster there). The CPU reference always uses its BVH.
+    #[arg(long, value_enum, default_value_t = TraversalChoice::Auto)]
+    pub traversal: TraversalChoice,
     /// Stop at the first batch boundary after this many seconds and write what is done.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
@@ -205,9 +210,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
     args.post.check()?;
 
     let gpu = open_gpu(&args)?;
-    let mut renderer: Box<dyn Renderer + '_> = match &gpu {
-        Some(ctx) => Box::new(GpuRenderer::new(ctx, &kernel_scene)?),
-        None => Box::new(CpuRenderer::new(&kernel_scene)),
+    // The CPU reference traverses its BVH whatever --traversal says.
+    let traversal = match &gpu {
+        Some(ctx) => Some(args.traversal.resolve(ctx)?),
+        None => None,
+    };
+    let mut renderer: Box<dyn Renderer + '_> = match (&gpu, traversal) {
+        (Some(ctx), Some(traversal)) => {
+            Box::new(GpuRenderer::with_traversal(ctx, &kernel_scene, traversal)?)
+        }
+        _ => Box::new(CpuRenderer::new(&kernel_scene)),
     };
 
     plan.start(renderer.as_mut())?;
@@ -313,6 +325,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "nonfinite_samples": renderer.nonfinite_samples(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
+            // The GPU's traversal; the CPU reference's is its BVH ("software").
+            "traversal": traversal.unwrap_or(crate::gpu::Traversal::Software).name(),
             "triangles": kernel_scene.triangles.len(),
             "bvh_nodes": kernel_scene.bvh_nodes.len(),
             "bvh_build_seconds": kernel_scene.bvh_build_seconds,

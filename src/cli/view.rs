@@ -3,6 +3,7 @@
 use super::model::ModelArgs;
 use super::tone::ToneArgs;
 use crate::error::InputError;
+use crate::gpu::TraversalChoice;
 use crate::scene::MAX_IMAGE_SIDE;
 use crate::viewer::{action::Script, ViewOptions};
 use anyhow::Result;
@@ -29,6 +30,10 @@ pub struct ViewArgs {
     /// On exit, write what is shown (.png) or the linear mean radiance (.exr).
     #[arg(long, value_name = "FILE")]
     pub screenshot: Option<PathBuf>,
+    /// How the kernel finds hits: hardware (ray queries), software (glint's BVH) or auto (as
+    /// for `render`).
+    #[arg(long, value_enum, default_value_t = TraversalChoice::Auto)]
+    pub traversal: TraversalChoice,
     #[command(flatten)]
     pub tone: ToneArgs,
     #[command(flatten)]
@@ -58,5 +63,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
         display: args.tone.transform(),
         script,
         log_frames: args.log_frames,
+        traversal: args.traversal,
     })
 }

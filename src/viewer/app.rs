@@ -317,7 +317,8 @@ impl App {
             view_formats: vec![],
         };
         surface.configure(&ctx.device, &config);
-        let renderer = GpuRenderer::new(ctx, &self.kernel_scene())?;
+        let traversal = self.options.traversal.resolve(ctx)?;
+        let renderer = GpuRenderer::with_traversal(ctx, &self.kernel_scene(), traversal)?;
         let mut display = DisplayPass::new(&ctx.device, format);
         display.bind(&ctx.device, renderer.mean_buffer());
         crate::errln!(
@@ -349,7 +350,9 @@ impl App {
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
-        gpu.renderer = GpuRenderer::new(gpu.ctx, &kernel_scene)?;
+        // The same traversal as before: the device has not changed.
+        let traversal = gpu.renderer.traversal();
+        gpu.renderer = GpuRenderer::with_traversal(gpu.ctx, &kernel_scene, traversal)?;
         gpu.display
             .bind(&gpu.ctx.device, gpu.renderer.mean_buffer());
         gpu.showing_denoised = false;

@@ -45,6 +45,8 @@ pub struct ViewOptions {
     pub script: Script,
     /// One JSON line per frame and per event on stdout (tests, measurements).
     pub log_frames: bool,
+    /// `--traversal`: how the kernel finds hits, resolved once the device is open.
+    pub traversal: crate::gpu::TraversalChoice,
 }
 
 /// Wanted duration of a frame's batch of samples: a responsive ~30 frames per second.
