@@ -1,7 +1,9 @@
 // BVH traversal (mirror: src/cpu/bvh.rs). One BVH over every sphere, quad and triangle, built
 // on the host (src/scene/bvh.rs) and flattened into bvh_nodes. A fixed stack, the nearer child
 // first, and popped nodes skipped when they start beyond the closest hit so far. Shadow rays
-// stop at the first primitive in front of the one they aim at.
+// stop at the first primitive in front of the one they aim at. Which hit is the closest, and
+// which primitives are in front, is the closest-hit rule's (hit_comes_first), whatever the
+// order of visits.
 
 // The traversal stack's length, BVH_STACK_SIZE, comes from the host with the scene's layout:
 // enough for this scene's tree (kernel_stack_size in src/scene/bvh.rs).
@@ -67,20 +69,57 @@ fn hit_primitive(reference: u32, r: BvhRay) -> f32 {
     return hit_sphere(spheres[index], r.ray);
 }
 
-// The closest primitive through the BVH. With `shadow_target` not NO_PRIMITIVE, it is a shadow
-// ray's test instead: t_max is the target's distance, and the first other primitive nearer than
-// that ends the search (returned with its t); none found returns t = NO_HIT.
+// Where r enters the box of the primitive `reference` (the box the host builds the BVH over:
+// primitive_boxes in src/scene/bvh.rs, the same arithmetic), or NO_HIT.
+fn primitive_box_entry(reference: u32, r: BvhRay) -> f32 {
+    let kind = reference >> PRIMITIVE_KIND_SHIFT;
+    let index = reference & PRIMITIVE_INDEX_MASK;
+    var bounds: BvhNode;
+    if kind == PRIMITIVE_TRIANGLE {
+        let t = triangles[index];
+        bounds.min = min(min(t.v0, t.v1), t.v2);
+        bounds.max = max(max(t.v0, t.v1), t.v2);
+    } else if kind == PRIMITIVE_QUAD {
+        let q = quads[index];
+        let pu = q.corner + q.edge_u;
+        let pv = q.corner + q.edge_v;
+        let puv = pu + q.edge_v;
+        bounds.min = min(min(q.corner, pu), min(pv, puv));
+        bounds.max = max(max(q.corner, pu), max(pv, puv));
+    } else {
+        let s = spheres[index];
+        bounds.min = s.center - vec3<f32>(s.radius);
+        bounds.max = s.center + vec3<f32>(s.radius);
+    }
+    return hit_box(bounds, r, NO_HIT);
+}
+
+// The closest primitive through the BVH that comes before the bound (t_max, max_reference) by
+// the closest-hit rule (hit_comes_first); a closest-hit search passes (NO_HIT, 0), which no
+// miss comes before. With `shadow_target` not NO_PRIMITIVE, it is a shadow ray's test instead:
+// the bound is the target's hit, and the first other primitive before it ends the search
+// (returned with its t); none found returns t = NO_HIT.
+//
+// Boxes are skipped when the ray enters them beyond t_prune (at least t_max), and once a hit is
+// found, beyond its t or, if later, where the ray enters the box of the leaf it is in. Rounding
+// can put a primitive's t a few ulps before its own box's entry, so a copy of it (hit at the
+// same t, and coming before it by the rule) in a box of its own, the same box, must be compared
+// against that entry, not the t, or it would be skipped.
 const NO_PRIMITIVE: u32 = 0xffffffffu;
 
-fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
+fn bvh_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
     var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u);
+    var best_reference = max_reference;
+    var prune = t_prune;
     var found = false;
     // Node indices only: a popped node's entry distance is recomputed (the same arithmetic,
     // so the same decision), which halves the per-lane stack lavapipe keeps in memory.
     var stack: array<u32, BVH_STACK_SIZE>;
     var top = 0u;
     var node_index = 0u;
-    if hit_box(bvh_node(0u), r, best.t) == NO_HIT {
+    // Where the ray enters the node being entered.
+    var node_entry = hit_box(bvh_node(0u), r, prune);
+    if node_entry == NO_HIT {
         return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
     }
     loop {
@@ -89,8 +128,12 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
             for (var i = 0u; i < node.count; i++) {
                 let reference = bvh_primitives[node.first + i];
                 let t = hit_primitive(reference, r);
-                if t < best.t && reference != shadow_target {
+                // The target is excluded by name too, not only by the rule: the compiler may
+                // round its test here and in bvh_first_hit_is differently.
+                if hit_comes_first(t, reference, best.t, best_reference) && reference != shadow_target {
                     best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK);
+                    best_reference = reference;
+                    prune = max(t, node_entry);
                     found = true;
                     if shadow_target != NO_PRIMITIVE {
                         return best;
@@ -99,30 +142,35 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
             }
         } else {
             let left = node.first;
-            let t_left = hit_box(bvh_node(left), r, best.t);
-            let t_right = hit_box(bvh_node(left + 1u), r, best.t);
+            let t_left = hit_box(bvh_node(left), r, prune);
+            let t_right = hit_box(bvh_node(left + 1u), r, prune);
             if t_left != NO_HIT && t_right != NO_HIT {
                 let left_first = t_left <= t_right;
                 stack[top] = select(left, left + 1u, left_first);
                 top += 1u;
                 node_index = select(left + 1u, left, left_first);
+                node_entry = min(t_left, t_right);
                 continue;
             }
             if t_left != NO_HIT {
                 node_index = left;
+                node_entry = t_left;
                 continue;
             }
             if t_right != NO_HIT {
                 node_index = left + 1u;
+                node_entry = t_right;
                 continue;
             }
         }
-        // Pop the next node that may still hold something nearer than the best hit.
+        // Pop the next node that may still hold something before the best hit.
         var popped = false;
         while top > 0u {
             top -= 1u;
-            if hit_box(bvh_node(stack[top]), r, best.t) != NO_HIT {
+            let entry = hit_box(bvh_node(stack[top]), r, prune);
+            if entry != NO_HIT {
                 node_index = stack[top];
+                node_entry = entry;
                 popped = true;
                 break;
             }
@@ -138,12 +186,12 @@ fn bvh_traverse(r: BvhRay, t_max: f32, shadow_target: u32) -> ClosestPrimitive {
 }
 
 fn bvh_closest_primitive(ray: Ray) -> ClosestPrimitive {
-    return bvh_traverse(bvh_ray(ray), NO_HIT, NO_PRIMITIVE);
+    return bvh_traverse(bvh_ray(ray), NO_HIT, NO_HIT, 0u, NO_PRIMITIVE);
 }
 
 // Whether ray hits nothing: a shadow-ray search for any hit, with no target.
 fn bvh_escapes(ray: Ray) -> bool {
-    return bvh_traverse(bvh_ray(ray), NO_HIT, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
+    return bvh_traverse(bvh_ray(ray), NO_HIT, NO_HIT, 0u, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
 }
 
 fn bvh_first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
@@ -153,5 +201,8 @@ fn bvh_first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
     if t_target == NO_HIT {
         return false;
     }
-    return bvh_traverse(r, t_target, target_ref).t == NO_HIT;
+    // Pruned no earlier than where the ray enters the target's own box: a primitive before it
+    // at the same t, a copy of it, is in a box the same as that one.
+    let t_prune = max(t_target, primitive_box_entry(target_ref, r));
+    return bvh_traverse(r, t_target, t_prune, target_ref, target_ref).t == NO_HIT;
 }

@@ -1,7 +1,7 @@
 // Lookups in the GGX albedo tables (mirror: src/cpu/ggx_energy.rs; the tables are made by
 // src/ggx_energy.rs, which says what they hold): bilinear in mu = cos(theta) and alpha.
 
-@group(0) @binding(24) var<storage, read> ggx_energy: array<f32>;
+@group(0) @binding(25) var<storage, read> ggx_energy: array<f32>;
 
 const GGX_ENERGY_SIZE: u32 = 32u;
 const GGX_ENERGY_OFFSET_A: u32 = 0u;

@@ -79,10 +79,26 @@ struct ClosestPrimitive {
     index: u32,
 }
 
+// The closest-hit rule, the same for every traversal on every device so that any structure
+// finds the same hit: the smallest t, and among equal t the lowest primitive reference,
+// (kind << PRIMITIVE_KIND_SHIFT) | index, that is spheres first, then quads, then triangles,
+// each by index. Whether a hit at t on `reference` comes before the best so far.
+fn hit_comes_first(t: f32, reference: u32, best_t: f32, best_reference: u32) -> bool {
+    return t < best_t || (t == best_t && reference < best_reference);
+}
+
 fn closest_primitive(ray: Ray) -> ClosestPrimitive {
     if USE_BVH {
         return bvh_closest_primitive(ray);
     }
+    return scan_closest_primitive(ray);
+}
+
+// The closest primitive by testing every one: the structure without a BVH, and what every other
+// traversal must agree with. It visits primitives in the closest-hit rule's order
+// (hit_comes_first) and keeps only strictly nearer hits, so among equal t the first, the lowest
+// reference, wins.
+fn scan_closest_primitive(ray: Ray) -> ClosestPrimitive {
     var best = ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
     for (var i = 0u; i < sphere_count(); i++) {
         let t = hit_sphere(spheres[i], ray);

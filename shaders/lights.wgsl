@@ -1,7 +1,8 @@
 // Light sampling for next-event estimation (mirror: src/cpu/lights.rs). An emitter is chosen
 // in proportion to its power, then a direction towards it: quads and triangles by area, spheres by the cone
 // of directions they subtend from outside, and by area from inside (where there is no cone), the
-// environment map by luminance (environment.wgsl).
+// environment map by luminance (environment.wgsl), point, spot and directional lights in
+// punctual.wgsl.
 // All pdfs are per unit solid angle at the shading point and include the selection probability.
 
 struct LightSample {
@@ -11,16 +12,32 @@ struct LightSample {
     radiance: vec3<f32>,
     primitive: u32,
     index: u32,
+    // A point, spot or delta sun: no BSDF-sampled ray reaches it, so its MIS weight is 1.
+    is_delta: bool,
 }
 
-// Selection by the emitters' cumulative probabilities.
-fn pick_emitter(u: f32) -> u32 {
-    for (var i = 0u; i + 1u < emitter_count(); i++) {
-        if u < emitters[i].cdf {
-            return i;
-        }
+// The emitter light sampling chose: which primitive, and the probability of choosing it.
+struct EmitterChoice {
+    primitive: u32,
+    index: u32,
+    probability: f32,
+}
+
+// Selection in proportion to power, in O(1) by the alias table (src/scene/kernel.rs): u picks
+// the slot, u_alias its emitter or the alias. The slot is floor(u * n) in f32 on both devices
+// (a correctly rounded product, then truncation), so both pick the same emitter.
+fn pick_emitter(u: f32, u_alias: f32) -> EmitterChoice {
+    let n = emitter_count();
+    let slot = emitters[min(u32(u * f32(n)), n - 1u)];
+    if u_alias < slot.alias_threshold {
+        return EmitterChoice(slot.primitive, slot.index, slot.probability);
     }
-    return emitter_count() - 1u;
+    return EmitterChoice(slot.alias_primitive, slot.alias_index, slot.alias_probability);
+}
+
+// Whether an emitter is a point, spot or directional light (punctual.wgsl); checked first.
+fn emitter_is_light(primitive: u32) -> bool {
+    return HAS_LIGHTS && primitive == PRIMITIVE_LIGHT;
 }
 
 // Whether an emitter is the environment map; checked before the others, whose tests assume
@@ -98,10 +115,16 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
     if emitter_count() == 0u {
         return out;
     }
-    let e = emitters[pick_emitter(rng_next(rng))];
+    let u_slot = rng_next(rng);
+    let u_alias = rng_next(rng);
+    let e = pick_emitter(u_slot, u_alias);
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     out.primitive = e.primitive;
     out.index = e.index;
+    out.is_delta = false;
+    if emitter_is_light(e.primitive) {
+        return sample_punctual(e.index, e.probability, p, u);
+    }
     if emitter_is_environment(e.primitive) {
         let s = sample_environment(u, rng);
         out.dir = s.dir;
@@ -198,6 +221,23 @@ fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, ind
         return s.light_probability * area_to_solid_angle(chord.t, chord.cos_exit, 4.0 * PI * s.radius * s.radius);
     }
     return s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p));
+}
+
+// Whether a shadow ray along a light sample reaches the light it sampled.
+fn light_visible(shadow: Ray, light: LightSample) -> bool {
+    if emitter_is_light(light.primitive) {
+        return punctual_visible(shadow, light);
+    }
+    return first_hit_is(shadow, light.primitive, light.index);
+}
+
+// The MIS weight of a light sample against BSDF sampling, which would have drawn its direction
+// with bsdf_pdf: 1 for delta lights, which BSDF sampling cannot reach.
+fn nee_weight(light: LightSample, bsdf_pdf: f32) -> f32 {
+    if light.is_delta {
+        return 1.0;
+    }
+    return power_heuristic(light.pdf, bsdf_pdf);
 }
 
 // The largest finite f32.

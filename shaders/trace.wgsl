@@ -60,6 +60,10 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
                 escaped *= power_heuristic((*path).bsdf_pdf_of_ray, pdf);
             }
         }
+        if HAS_SUN_DISKS {
+            let mis = light_sampling && !(*path).came_from_delta;
+            escaped += sun_disks_radiance(ray.dir, (*path).bsdf_pdf_of_ray, mis);
+        }
         (*path).radiance += firefly_clamp((*path).throughput * escaped, bounce);
         return true;
     }
@@ -92,8 +96,8 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
             let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal);
             if any(f_cos > vec3<f32>(0.0)) {
                 segments += 1u;
-                if first_hit_is(Ray(origin, light.dir), light.primitive, light.index) {
-                    let weight = power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
+                if light_visible(Ray(origin, light.dir), light) {
+                    let weight = nee_weight(light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
                     (*path).radiance += firefly_clamp(contribution, bounce + 1u);
                 }

@@ -46,7 +46,7 @@ struct Params {
     environment_sin: f32,
     // Probability that light sampling picks the environment map (0 when it is not sampled).
     environment_light_probability: f32,
-    pad4: u32,
+    light_count: u32,
 }
 
 struct Sphere {
@@ -142,12 +142,16 @@ const PRIMITIVE_KIND_SHIFT: u32 = 30u;
 const PRIMITIVE_INDEX_MASK: u32 = 0x3fffffffu;
 
 // One entry per emitting primitive, for choosing one in proportion to its power.
+// One entry per emitter and one slot of the alias table over them (src/shader_types.rs).
 struct Emitter {
     primitive: u32,
     index: u32,
-    // Sum of the selection probabilities up to and including this emitter (the last is 1).
-    cdf: f32,
     probability: f32,
+    alias_threshold: f32,
+    alias_primitive: u32,
+    alias_index: u32,
+    alias_probability: f32,
+    _pad: u32,
 }
 
 const TEXTURE_IMAGE: u32 = 0u;
@@ -207,3 +211,24 @@ struct Ray {
 // Ray segments traced (camera, bounce and shadow rays), for benchmarks; wraps at 2^32, so the
 // host reads and clears it after each batch when it wants the figure.
 @group(0) @binding(7) var<storage, read_write> segments_traced: atomic<u32>;
+
+// The emitter table's entry for a point, spot or directional light (index into `lights`).
+const PRIMITIVE_LIGHT: u32 = 4u;
+
+const LIGHT_POINT: u32 = 0u;
+const LIGHT_SPOT: u32 = 1u;
+// A directional light: a delta sun when sun_one_minus_cos is 0, else a disk.
+const LIGHT_SUN: u32 = 2u;
+
+// A point, spot or directional light (src/shader_types.rs says what each field holds).
+struct Light {
+    position: vec3<f32>,
+    kind: u32,
+    direction: vec3<f32>,
+    light_probability: f32,
+    emitted: vec3<f32>,
+    spot_scale: f32,
+    spot_offset: f32,
+    sun_one_minus_cos: f32,
+    _pad: vec2<u32>,
+}

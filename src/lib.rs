@@ -17,6 +17,7 @@ pub mod compare;
 pub mod cpu;
 pub mod denoise;
 pub mod error;
+pub mod exr_header;
 pub mod ggx_energy;
 pub mod gpu;
 pub mod input_file;

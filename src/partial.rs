@@ -58,7 +58,7 @@ pub struct Partial {
 
 /// A hash of everything that decides the image besides the sample range: the kernel's view
 /// of the scene (camera, size, bounces, seed, light sampling, roulette, every object and
-/// material, textures, the environment map), with the per-batch sample fields cleared. The
+/// material, textures, the environment map, the lights), with the per-batch sample fields cleared. The
 /// arrays' bytes are hashed (exact, and fast for maps of millions of texels). The
 /// destructuring names every field, so a field added later fails to compile until it is
 /// hashed or said not to matter. The BVH is left out: it is derived from the primitives, its
@@ -80,6 +80,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         triangle_uvs,
         environment_texels,
         environment_alias,
+        lights,
     } = scene;
     let mut params = *params;
     params.sample_start = 0;
@@ -107,6 +108,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         bytemuck::cast_slice(environment_texels),
     );
     array("environment alias", bytemuck::cast_slice(environment_alias));
+    array("lights", bytemuck::cast_slice(lights));
     let mut hex = String::with_capacity(64);
     for byte in hasher.finalize() {
         write!(hex, "{byte:02x}").expect("writing to a String");
@@ -194,14 +196,16 @@ impl Partial {
             AnyChannels::sort(channels),
         );
         let image = exr::prelude::Image::from_layer(layer);
+        let mut bytes = Vec::new();
+        image
+            .write()
+            .to_buffered(std::io::Cursor::new(&mut bytes))
+            .with_context(|| format!("cannot encode {}", path.display()))?;
+        crate::exr_header::sort_attributes(&mut bytes)
+            .map_err(|e| anyhow::anyhow!("cannot encode {}: {e}", path.display()))?;
         // Through a temporary file next to `path`, then a rename (src/atomic_write.rs): a
         // reader never sees half a file, and nothing is left on an error.
-        crate::atomic_write::write_atomically_via_path(path, |tmp| {
-            image
-                .write()
-                .to_file(tmp)
-                .with_context(|| format!("cannot encode {}", path.display()))
-        })
+        crate::atomic_write::write_atomically(path, |w| std::io::Write::write_all(w, &bytes))
     }
 
     /// Reads a partial file. Every problem (not an EXR, truncated, a missing channel or

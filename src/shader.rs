@@ -2,13 +2,13 @@
 
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, Material, Quad, Sphere, MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR,
-    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, Emitter, Material, Quad, Sphere, LIGHT_SUN, MATERIAL_DIELECTRIC, MATERIAL_METAL,
+    MATERIAL_PBR, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 24] = [
+pub const SHADER_PARTS: [(&str, &str); 25] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -44,6 +44,7 @@ pub const SHADER_PARTS: [(&str, &str); 24] = [
         include_str!("../shaders/environment.wgsl"),
     ),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
+    ("punctual.wgsl", include_str!("../shaders/punctual.wgsl")),
     ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
     (
         "accumulate.wgsl",
@@ -230,6 +231,10 @@ pub struct KernelFeatures {
     /// An environment map (`[environment]`, shaders/environment.wgsl) in place of the
     /// constant background, and light sampling of it when that is on.
     pub environment: bool,
+    /// Point, spot and directional lights, sampled by light sampling (shaders/punctual.wgsl).
+    pub lights: bool,
+    /// Sun disks, which rays that escape can see (with or without light sampling).
+    pub sun_disks: bool,
 }
 
 impl KernelFeatures {
@@ -245,14 +250,17 @@ impl KernelFeatures {
         aovs: true,
         textures: true,
         environment: true,
+        lights: true,
+        sun_disks: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
     pub fn of(scene: &KernelScene) -> KernelFeatures {
         let emits = |primitive| scene.emitters.iter().any(|e| e.primitive == primitive);
         let has_kind = |kind| scene.materials.iter().any(|m| m.kind == kind);
+        let light_sampling = scene.params.light_sampling != 0 && !scene.emitters.is_empty();
         KernelFeatures {
-            light_sampling: scene.params.light_sampling != 0 && !scene.emitters.is_empty(),
+            light_sampling,
             sphere_emitters: emits(PRIMITIVE_SPHERE),
             quad_emitters: emits(PRIMITIVE_QUAD),
             triangle_emitters: emits(PRIMITIVE_TRIANGLE),
@@ -262,6 +270,11 @@ impl KernelFeatures {
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
             environment: scene.params.environment_width > 0,
+            lights: light_sampling && emits(PRIMITIVE_LIGHT),
+            sun_disks: scene
+                .lights
+                .iter()
+                .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
         }
     }
 
@@ -278,6 +291,8 @@ impl KernelFeatures {
             && needs(self.aovs, other.aovs)
             && needs(self.textures, other.textures)
             && needs(self.environment, other.environment)
+            && needs(self.lights, other.lights)
+            && needs(self.sun_disks, other.sun_disks)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -287,7 +302,8 @@ impl KernelFeatures {
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
              const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
              const AOVS: bool = {};\n\
-             const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n",
+             const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
+             const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -297,7 +313,9 @@ impl KernelFeatures {
             self.pbr,
             self.aovs,
             self.textures,
-            self.environment
+            self.environment,
+            self.lights,
+            self.sun_disks
         )
     }
 }

@@ -50,7 +50,8 @@ pub struct Params {
     pub environment_sin: f32,
     /// Probability that light sampling picks the environment map (0 when it is not sampled).
     pub environment_light_probability: f32,
-    pub pad4: u32,
+    /// Point, spot and directional lights (`lights`).
+    pub light_count: u32,
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.
@@ -123,15 +124,22 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 pub const PRIMITIVE_SPHERE: u32 = 0;
 pub const PRIMITIVE_QUAD: u32 = 1;
 
-/// One entry per emitting primitive, for choosing one in proportion to its power.
+/// One entry per emitting primitive, and one slot of Vose's alias table over them, for
+/// choosing an emitter in proportion to its power in O(1): slot k keeps its own emitter with
+/// probability `alias_threshold`, else takes the one copied into `alias_*` (copied, not
+/// referred to by index, so a pick reads one entry).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Emitter {
     pub primitive: u32,
     pub index: u32,
-    /// Sum of the selection probabilities up to and including this emitter (the last is 1).
-    pub cdf: f32,
+    /// The probability that light sampling picks this emitter.
     pub probability: f32,
+    pub alias_threshold: f32,
+    pub alias_primitive: u32,
+    pub alias_index: u32,
+    pub alias_probability: f32,
+    pub _pad: u32,
 }
 
 pub const PRIMITIVE_TRIANGLE: u32 = 2;
@@ -227,4 +235,36 @@ pub struct EnvironmentTexel {
 pub struct EnvironmentAlias {
     pub threshold: f32,
     pub alias_texel: u32,
+}
+
+/// The emitter table's entry for a point, spot or directional light (`index` into the lights).
+pub const PRIMITIVE_LIGHT: u32 = 4;
+
+pub const LIGHT_POINT: u32 = 0;
+pub const LIGHT_SPOT: u32 = 1;
+/// A directional light: a delta sun when `sun_one_minus_cos` is 0, else a disk.
+pub const LIGHT_SUN: u32 = 2;
+
+/// A point, spot or directional light (`src/scene/light.rs` builds them,
+/// `shaders/punctual.wgsl` samples them).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Light {
+    pub position: [f32; 3],
+    /// `LIGHT_POINT`, `LIGHT_SPOT` or `LIGHT_SUN`.
+    pub kind: u32,
+    /// Unit: the way the light travels (a spot's axis, the sun's rays).
+    pub direction: [f32; 3],
+    /// Probability that light sampling picks this light.
+    pub light_probability: f32,
+    /// Point and spot: radiant intensity (W/sr); delta sun: irradiance (W/m²); sun disk: the
+    /// disk's radiance. Per channel, colour included.
+    pub emitted: [f32; 3],
+    /// glTF's spot falloff clamp(cos · scale + offset, 0, 1)²; scale 0 and offset 1 (no
+    /// falloff) for the others.
+    pub spot_scale: f32,
+    pub spot_offset: f32,
+    /// 1 − cos of a sun disk's half angle (0: a delta sun).
+    pub sun_one_minus_cos: f32,
+    pub _pad: [u32; 2],
 }

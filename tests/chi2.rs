@@ -231,8 +231,11 @@ fn reference_light_pdf(scene: &glint::scene::Scene, p: glam::DVec3, dir: glam::D
             let n = (p + t * dir - c) / r;
             pdf += w / total * t * t / (n.dot(dir).abs() * 4.0 * PI * r * r);
         } else {
+            // A sample drawn at the cone's very edge is a direction rounded to f32 (relative
+            // error ~6e-8), which may land a hair outside it: the reference cone is wider by
+            // 1e-6 in cos, a sliver of 2π·1e-6 sr that changes no cell's expected count.
             let cos_max = (1.0 - r * r / oc.dot(oc)).sqrt();
-            if dir.dot(oc.normalize()) >= cos_max {
+            if dir.dot(oc.normalize()) >= cos_max - 1e-6 {
                 pdf += w / total / (2.0 * PI * (1.0 - cos_max));
             }
         }
@@ -374,6 +377,149 @@ fn gpu_light_sampling() {
         let samples = run_probe(ctx, "probe_light", params, &scene.kernel_scene());
         check_light_samples(&format!("gpu light sampling, {name}"), &scene, p, &samples);
     }
+}
+
+// ---- Emitter choice (the alias table) -------------------------------------------------------
+
+/// Emitters of very unequal power: 60 quads of growing size in three strengths (some expect
+/// fewer than five picks, which the χ² pools), two spheres, and lights_with_triangles' four
+/// triangles.
+fn many_emitters() -> glint::scene::Scene {
+    let mut toml = String::new();
+    for k in 0..60 {
+        let side = 0.02 * (k + 1) as f32;
+        toml += &format!(
+            "[[quads]]\ncorner = [{x}, 3.0, 0.0]\nu = [{side}, 0.0, 0.0]\nv = [0.0, 0.0, {side}]\n\
+             material = \"quad_lamp_{m}\"\n",
+            x = k as f32,
+            m = k % 3
+        );
+    }
+    for (m, strength) in [0.01, 1.0, 40.0].iter().enumerate() {
+        toml += &format!(
+            "[materials.quad_lamp_{m}]\ntype = \"diffuse\"\ncolor = [0.0, 0.0, 0.0]\n\
+             emission = [1.0, 0.5, 0.25]\nstrength = {strength}\n"
+        );
+    }
+    toml += "[[spheres]]\ncenter = [0.0, -5.0, 0.0]\nradius = 0.3\nmaterial = \"ball_lamp\"\n";
+    let mut scene = lights_with_triangles();
+    let extra = common::scene(&format!("{SCENE_HEADER}{TWO_LIGHTS}{toml}"));
+    // The triangles refer to materials by index: keep TWO_LIGHTS' materials first.
+    let offset = scene.materials.len() as u32;
+    scene.materials.extend(extra.materials);
+    scene.quads.extend(extra.quads.into_iter().map(|mut q| {
+        q.material += offset;
+        q
+    }));
+    scene.spheres.extend(extra.spheres.into_iter().map(|mut s| {
+        s.material += offset;
+        s
+    }));
+    scene
+}
+
+/// Each emitter (primitive, index) with the probability of picking it, power / total power,
+/// computed here in f64 from the scene alone.
+fn reference_emitter_probabilities(scene: &glint::scene::Scene) -> Vec<((u32, u32), f64)> {
+    use glint::shader_types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE};
+    let power = |material: u32| {
+        scene.materials[material as usize]
+            .emitted_radiance
+            .as_dvec3()
+            .element_sum()
+            / 3.0
+    };
+    let mut powers: Vec<((u32, u32), f64)> = Vec::new();
+    for (i, s) in scene.spheres.iter().enumerate() {
+        let p = power(s.material) * 4.0 * PI * (s.radius as f64).powi(2);
+        powers.push(((PRIMITIVE_SPHERE, i as u32), p));
+    }
+    for (i, q) in scene.quads.iter().enumerate() {
+        let p = power(q.material) * q.u.as_dvec3().cross(q.v.as_dvec3()).length();
+        powers.push(((PRIMITIVE_QUAD, i as u32), p));
+    }
+    for (i, t) in scene.triangles.iter().enumerate() {
+        let [a, b, c] = t.vertices.map(|v| v.as_dvec3());
+        let p = power(t.material) * 0.5 * (b - a).cross(c - a).length();
+        powers.push(((PRIMITIVE_TRIANGLE, i as u32), p));
+    }
+    powers.retain(|p| p.1 > 0.0);
+    let total: f64 = powers.iter().map(|p| p.1).sum();
+    powers.into_iter().map(|(e, p)| (e, p / total)).collect()
+}
+
+/// Picks (primitive, index, reported probability) against the emitters' probabilities, by χ²;
+/// and every reported probability must be, exactly, the one light_pdf uses for that emitter
+/// (the primitive's `light_probability`), so MIS stays consistent with the pick.
+fn check_emitter_choices(name: &str, scene: &glint::scene::Scene, picks: &[[f32; 4]]) {
+    use glint::shader_types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE};
+    let kernel = scene.kernel_scene();
+    let reference = reference_emitter_probabilities(scene);
+    let ordinal: std::collections::HashMap<(u32, u32), usize> = reference
+        .iter()
+        .enumerate()
+        .map(|(k, (e, _))| (*e, k))
+        .collect();
+    let mut observed = vec![0u64; reference.len()];
+    for pick in picks {
+        let (primitive, index) = (pick[0] as u32, pick[1] as u32);
+        let k = *ordinal
+            .get(&(primitive, index))
+            .unwrap_or_else(|| panic!("{name}: picked ({primitive}, {index}), not an emitter"));
+        observed[k] += 1;
+        let light_probability = match primitive {
+            PRIMITIVE_SPHERE => kernel.spheres[index as usize].light_probability,
+            PRIMITIVE_QUAD => kernel.quads[index as usize].light_probability,
+            PRIMITIVE_TRIANGLE => kernel.triangles[index as usize].light_probability,
+            _ => unreachable!(),
+        };
+        assert_eq!(pick[2], light_probability, "{name}: ({primitive}, {index})");
+    }
+    let expected: Vec<f64> = reference
+        .iter()
+        .map(|(_, p)| p * picks.len() as f64)
+        .collect();
+    assert_fits(name, &Ok(pearson(&observed, &expected)));
+}
+
+fn cpu_emitter_choices(scene: &glint::scene::KernelScene, seed: u32) -> Vec<[f32; 4]> {
+    let refs = glint::cpu::trace::SceneRefs::of(scene, &scene.params);
+    (0..SAMPLES)
+        .map(|i| {
+            let mut r = cpu_draws(i, seed);
+            let (u_slot, u_alias) = (r.next_f32(), r.next_f32());
+            let e = glint::cpu::lights::pick_emitter(&refs, u_slot, u_alias);
+            [e.primitive as f32, e.index as f32, e.probability, 0.0]
+        })
+        .collect()
+}
+
+#[test]
+fn cpu_emitter_choice() {
+    let scene = many_emitters();
+    let picks = cpu_emitter_choices(&scene.kernel_scene(), SEED + 41);
+    check_emitter_choices("cpu emitter choice", &scene, &picks);
+}
+
+/// The GPU's picks fit the probabilities, and are the CPU's, pick for pick.
+#[test]
+fn gpu_emitter_choice() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = many_emitters();
+    let kernel = scene.kernel_scene();
+    let picks = run_probe(
+        ctx,
+        "probe_emitter_choice",
+        probe(Vec3::Z, SAMPLES, SEED + 43),
+        &kernel,
+    );
+    check_emitter_choices("gpu emitter choice", &scene, &picks);
+    let cpu = cpu_emitter_choices(&kernel, SEED + 43);
+    let differ = picks.iter().zip(&cpu).filter(|(g, c)| g != c).count();
+    assert_eq!(
+        differ, 0,
+        "{differ} of {SAMPLES} GPU picks differ from the CPU's"
+    );
 }
 
 // ---- Metal (GGX, visible normals) ----------------------------------------------------------
@@ -810,6 +956,83 @@ fn gpu_environment_sampling() {
         );
         check_environment_samples(case, &format!("gpu environment, {}", case.name), &samples);
     }
+}
+
+// ---- Sun disks -------------------------------------------------------------------------------
+
+/// A sun of 2° angular diameter (no other emitter), travelling along `SUN_DIRECTION`.
+const SUN: &str = r#"
+[materials.grey]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+[[spheres]]
+center = [0.0, -50.0, 0.0]
+radius = 1.0
+material = "grey"
+[[lights]]
+type = "directional"
+direction = [0.3, -0.9, 0.2]
+intensity = 2.0
+angle = 2.0
+"#;
+
+/// Sun-disk samples, uniform in the disk's solid angle: (1 − cos θ) / (1 − cos θmax) and
+/// φ / 2π about the axis are then uniform on [0, 1]², which the χ² checks on 32 × 32 cells;
+/// every sample reports the uniform pdf 1 / (2π (1 − cos θmax)) and lies in the cone.
+fn check_sun_samples(name: &str, samples: &[[f32; 4]]) {
+    use glam::DVec3;
+    let axis = -DVec3::new(0.3, -0.9, 0.2).normalize();
+    let half = 1.0f64.to_radians();
+    let one_minus_cos_max = 1.0 - half.cos();
+    let expected_pdf = 1.0 / (2.0 * PI * one_minus_cos_max);
+    let (t, b) = {
+        let t = axis.cross(DVec3::Y).normalize();
+        (t, axis.cross(t))
+    };
+    let cells: Vec<[f32; 2]> = samples
+        .iter()
+        .map(|s| {
+            let d = DVec3::new(s[0] as f64, s[1] as f64, s[2] as f64).normalize();
+            assert!(
+                (s[3] as f64 / expected_pdf - 1.0).abs() < 1e-4,
+                "{name}: pdf {} vs {expected_pdf}",
+                s[3]
+            );
+            let one_minus_cos = 0.5 * (d - axis).length_squared();
+            let u = one_minus_cos / one_minus_cos_max;
+            assert!(u <= 1.0 + 1e-3, "{name}: {d} is outside the disk ({u})");
+            let phi = d.dot(b).atan2(d.dot(t)).rem_euclid(2.0 * PI) / (2.0 * PI);
+            [u.min(0.999_999) as f32, (phi as f32).min(0.999_999)]
+        })
+        .collect();
+    assert_fits(name, &Ok(uniform_2d(&cells, 32)));
+}
+
+#[test]
+fn cpu_sun_disk_sampling() {
+    let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
+    let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
+    let samples: Vec<[f32; 4]> = (0..SAMPLES)
+        .map(|i| {
+            let mut r = cpu_draws(i, SEED + 51);
+            let s = glint::cpu::lights::sample_light(&refs, Vec3::ZERO, Vec3::ZERO, &mut r);
+            [s.dir.x, s.dir.y, s.dir.z, s.pdf]
+        })
+        .collect();
+    check_sun_samples("cpu sun disk", &samples);
+}
+
+#[test]
+fn gpu_sun_disk_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
+    let samples = run_probe(
+        ctx,
+        "probe_light",
+        probe(Vec3::Z, SAMPLES, SEED + 53),
+        &kernel,
+    );
+    check_sun_samples("gpu sun disk", &samples);
 }
 
 /// The PBR material's sampler: with probability p (from the lobes' albedos) the visible-normal

@@ -364,7 +364,11 @@ fn bad_environments_are_named_errors() {
             env("negative.exr", ""),
             vec![(
                 "negative.exr",
-                exr_bytes(&[[1.0; 3], [1.0; 3], [1.0; 3], [0.0, -1.0, 0.0]], 2, 2),
+                exr_bytes(
+                    &[[1.0; 3], [1.0; 3], [1.0; 3], [0.0, f32::NEG_INFINITY, 0.0]],
+                    2,
+                    2,
+                ),
             )],
             vec!["texel (1, 1)", "finite radiances ≥ 0"],
         ),
@@ -506,6 +510,186 @@ fn the_albedo_aov_of_escaping_rays_is_the_maps_clamped_radiance() {
             aovs.albedo.pixels.iter().all(|p| *p == [0.25, 0.5, 1.0]),
             "{device}: {:?}",
             &aovs.albedo.pixels[..2]
+        );
+    }
+}
+
+// ---- Files as they come: EXR compressions and lossy codecs' negatives ----
+
+/// A map with tiny negative texels (what lossy EXR compression leaves near black) renders,
+/// with those set to 0 and one warning line saying how many and the most negative.
+#[test]
+fn tiny_negative_texels_are_clamped_with_one_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    write_map(dir.path(), "m.exr", 2, 1, |x, _| {
+        if x == 0 {
+            [1.0, -4.5e-6, -1e-7]
+        } else {
+            [0.5; 3]
+        }
+    });
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(
+        &scene,
+        format!("{BAD_SCENE}[environment]\nfile = \"m.exr\"\n"),
+    )
+    .unwrap();
+    let loaded = Scene::load(&scene).unwrap_or_else(|e| panic!("{e}"));
+    let image = &loaded.environment.as_ref().unwrap().image;
+    assert_eq!(image.texels[0], [1.0, 0.0, 0.0]);
+    let out = dir.path().join("out.png");
+    let run = common::run_render("--cpu", &scene, &out);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    let warnings: Vec<_> = stderr.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(
+        warnings[0].contains("m.exr: 2 negative values (the most negative -4.5e-6) set to 0"),
+        "{stderr}"
+    );
+}
+
+/// How far a codec may move a value, relative to it: 0 for the lossless ones (and for the
+/// lossy ones on channels they store as they are); PXR24 rounds f32 to 15 mantissa bits
+/// (relative error ≤ 2⁻¹⁶ ≈ 1.5e-5, reached here); B44 stores each 4×4 block
+/// of halves as a base and 6-bit differences (1.8e-3 measured); DWA quantizes a DCT (1.0e-2
+/// measured). The bounds are about twice what these smooth images measure.
+fn codec_tolerance(compression: exr::prelude::Compression, half: bool) -> f32 {
+    use exr::prelude::Compression::*;
+    match compression {
+        Uncompressed | RLE | ZIP1 | ZIP16 | PIZ => 0.0,
+        PXR24 if half => 0.0,
+        PXR24 => 3e-5,
+        B44 | B44A if half => B44_TOLERANCE,
+        B44 | B44A => 0.0,
+        _ => DWA_TOLERANCE,
+    }
+}
+const B44_TOLERANCE: f32 = 4e-3;
+const DWA_TOLERANCE: f32 = 0.02;
+
+/// Every compression the exr crate writes (all of OpenEXR's but HTJ2K), with f32 and with f16
+/// texels: glint reads back what was written, exactly for the lossless codecs and within each
+/// lossy codec's error.
+#[test]
+fn every_exr_compression_loads() {
+    use exr::prelude::*;
+    use glint::scene::image::{load_linear_image, Encoding as Decode};
+    let (width, height) = (48usize, 40usize);
+    // Smooth, positive and bright enough that no lossy codec goes below 0.
+    let value = |x: usize, y: usize, c: usize| {
+        0.2 + 0.5 * (x as f32 / width as f32) + 0.3 * (y as f32 / height as f32) + 0.1 * c as f32
+    };
+    let dir = tempfile::tempdir().unwrap();
+    for compression in [
+        Compression::Uncompressed,
+        Compression::RLE,
+        Compression::ZIP1,
+        Compression::ZIP16,
+        Compression::PIZ,
+        Compression::PXR24,
+        Compression::B44,
+        Compression::B44A,
+        Compression::DWAA(None),
+        Compression::DWAB(None),
+    ] {
+        for half in [false, true] {
+            let name = format!("{compression}-{}", if half { "f16" } else { "f32" });
+            let path = dir.path().join(format!("{name}.exr").replace(' ', "_"));
+            let encoding = Encoding {
+                compression,
+                blocks: Blocks::ScanLines,
+                line_order: LineOrder::Increasing,
+            };
+            let written = if half {
+                let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+                    (
+                        f16::from_f32(value(x, y, 0)),
+                        f16::from_f32(value(x, y, 1)),
+                        f16::from_f32(value(x, y, 2)),
+                    )
+                });
+                Image::from_encoded_channels((width, height), encoding, channels)
+                    .write()
+                    .to_file(&path)
+            } else {
+                let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+                    (value(x, y, 0), value(x, y, 1), value(x, y, 2))
+                });
+                Image::from_encoded_channels((width, height), encoding, channels)
+                    .write()
+                    .to_file(&path)
+            };
+            written.unwrap_or_else(|e| panic!("{name}: {e}"));
+            let image =
+                load_linear_image(&path, Decode::Linear).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!((image.width, image.height), (width as u32, height as u32));
+            let tolerance = codec_tolerance(compression, half);
+            let mut worst = 0.0f32;
+            for y in 0..height {
+                for x in 0..width {
+                    let texel = image.texel(x as u32, y as u32);
+                    for (c, read) in texel.iter().enumerate() {
+                        let mut expected = value(x, y, c);
+                        if half {
+                            expected = f16::from_f32(expected).to_f32();
+                        }
+                        worst = worst.max((read - expected).abs() / expected);
+                    }
+                }
+            }
+            eprintln!("{name}: largest relative error {worst:.2e}");
+            assert!(
+                worst <= tolerance,
+                "{name}: relative error {worst} > {tolerance}"
+            );
+        }
+    }
+}
+
+/// A DWAB map written by OpenEXR itself (tests/images/make_dwab.py says how): glint's decoder
+/// (the exr crate) reads the texels OpenEXR's own decoder does, negatives included, which
+/// are then clamped and reported.
+#[test]
+fn an_openexr_dwab_map_loads_as_openexr_decodes_it() {
+    use glint::scene::image::{load_linear_image, Encoding};
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/images");
+    let dwab = load_linear_image(&folder.join("dwab.exr"), Encoding::Linear).unwrap();
+    let reference = load_linear_image(&folder.join("dwab-decoded.exr"), Encoding::Linear).unwrap();
+    let clamped = dwab.clamped.expect("the DWAB map holds negatives");
+    assert_eq!(clamped.count, 94);
+    assert_eq!(clamped.most_negative, -2.574_920_7e-5);
+    assert_eq!(reference.clamped, dwab.clamped);
+    assert_eq!((dwab.width, dwab.height), (32, 16));
+    assert!(
+        dwab.texels == reference.texels,
+        "texels differ from OpenEXR's"
+    );
+}
+
+/// A compression the exr crate cannot read (OpenEXR 3.5's ZSTD, and HTJ2K) is refused with an
+/// error naming the file and the compression.
+#[test]
+fn an_unreadable_compression_is_named() {
+    let mut bytes = exr_bytes(&[[1.0; 3]; 4], 2, 2);
+    let key = b"compression\0compression\0\x01\0\0\0";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("a compression attribute")
+        + key.len();
+    for (code, name) in [(13, "ZSTD"), (10, "HTJ2K256")] {
+        bytes[at] = code;
+        let message = load_error(
+            "[environment]\nfile = \"m.exr\"\n",
+            &[("m.exr", bytes.clone())],
+        );
+        assert!(
+            message.contains("environment.file: m.exr: cannot decode the image")
+                && message.contains(&format!(
+                    "its EXR compression, {name}, is not one glint reads"
+                )),
+            "{message}"
         );
     }
 }

@@ -64,6 +64,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
         triangles: vec![],
         textures: Default::default(),
         environment: None,
+        lights: vec![],
     };
     scene.kernel_scene().quads[0]
 }

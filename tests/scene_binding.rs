@@ -201,6 +201,10 @@ fn compiled_out_features_do_not_change_the_image() {
             "textured",
             sized(shipped_scene("cornell-textured.toml"), 32, 4),
         ),
+        (
+            "point, spot and sun lights",
+            sized(shipped_scene("lights.toml"), 32, 7),
+        ),
     ];
     let mut variants_seen = Vec::new();
     for (name, scene) in scenes {
@@ -232,9 +236,11 @@ fn compiled_out_features_do_not_change_the_image() {
             f.metal,
             f.dielectric,
             f.textures,
+            f.lights,
+            f.sun_disks,
         ]
     };
-    for i in 0..6 {
+    for i in 0..8 {
         assert!(
             variants_seen.iter().any(|f| flags(f)[i]),
             "flag {i} never on"

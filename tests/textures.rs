@@ -426,6 +426,35 @@ fn color_texels_out_of_range() {
     );
 }
 
+/// Tiny negative texels (lossy EXR compression) are set to 0 with one warning, as in
+/// environment maps; the texture loads.
+#[test]
+fn tiny_negative_color_texels_are_clamped_with_one_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    image::Rgb32FImage::from_fn(2, 2, |x, y| {
+        image::Rgb([0.5, 0.5, if (x, y) == (1, 0) { -3e-6 } else { 0.5 }])
+    })
+    .save(dir.path().join("dark.exr"))
+    .unwrap();
+    let scene = scene_with(
+        dir.path(),
+        "type = \"diffuse\"\ncolor = { texture = \"dark.exr\" }",
+        4,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.textures.texels.iter().all(|t| t[2] >= 0.0));
+    let out = dir.path().join("out.png");
+    let run = common::run_render("--cpu", &dir.path().join("scene.toml"), &out);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    let warnings: Vec<_> = stderr.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(warnings.len(), 1, "{stderr}");
+    assert!(
+        warnings[0].contains("dark.exr: 1 negative value (the most negative -3e-6) set to 0"),
+        "{stderr}"
+    );
+}
+
 /// Runs `glint render` on a scene with a texture, expecting exit code 2, one line on stderr
 /// holding every needle, and no output file.
 fn assert_cli_refuses(png: Vec<u8>, device: &str, needles: &[&str]) {

@@ -1,10 +1,11 @@
 //! BVH traversal (WGSL side: `shaders/bvh.wgsl`). One BVH over every sphere, quad and triangle,
 //! built on the host (`src/scene/bvh.rs`) and flattened into `bvh_nodes`. A fixed stack, the
 //! nearer child first, and popped nodes skipped when they start beyond the closest hit so far.
-//! Shadow rays stop at the first primitive in front of the one they aim at. The order of
-//! visits is the kernel's, so ties between equally near primitives resolve the same way.
+//! Shadow rays stop at the first primitive in front of the one they aim at. Which hit is the
+//! closest, and which primitives are in front, is the closest-hit rule's
+//! ([`hit_comes_first`]), whatever the order of visits.
 
-use super::intersect::{hit_quad, hit_sphere, ClosestPrimitive, Geometry, NO_HIT};
+use super::intersect::{hit_comes_first, hit_quad, hit_sphere, ClosestPrimitive, Geometry, NO_HIT};
 use super::triangle::{hit_triangle, triangle_ray, TriangleRay};
 use super::Ray;
 use crate::shader_types::{
@@ -13,7 +14,7 @@ use crate::shader_types::{
 };
 use glam::{Vec3, Vec3A};
 
-/// Enough for any tree the host accepts: it rejects trees deeper than this.
+/// Enough for any tree the host builds: it bounds every tree's depth by this.
 pub const BVH_STACK_SIZE: usize = 64;
 
 /// No shadow target: [`bvh_traverse`] looks for the closest hit.
@@ -89,13 +90,23 @@ pub fn hit_primitive(geometry: &Geometry, reference: u32, r: &BvhRay) -> f32 {
     hit_sphere(&geometry.spheres[index], &r.ray)
 }
 
-/// The closest primitive through the BVH. With `shadow_target` not [`NO_PRIMITIVE`], it is a
-/// shadow ray's test instead: `t_max` is the target's distance, and the first other primitive
-/// nearer than that ends the search (returned with its t); none found returns t = `NO_HIT`.
+/// The closest primitive through the BVH that comes before the bound (`t_max`,
+/// `max_reference`) by the closest-hit rule ([`hit_comes_first`]); a closest-hit search passes
+/// (`NO_HIT`, 0), which no miss comes before. With `shadow_target` not [`NO_PRIMITIVE`], it is
+/// a shadow ray's test instead: the bound is the target's hit, and the first other primitive
+/// before it ends the search (returned with its t); none found returns t = `NO_HIT`.
+///
+/// Boxes are skipped when the ray enters them beyond `t_prune` (at least `t_max`), and once a
+/// hit is found, beyond its t or, if later, where the ray enters the box of the leaf it is in.
+/// Rounding can put a primitive's t a few ulps before its own box's entry, so a copy of it
+/// (hit at the same t, and coming before it by the rule) in a box of its own, the same box,
+/// must be compared against that entry, not the t, or it would be skipped.
 pub fn bvh_traverse(
     geometry: &Geometry,
     r: &BvhRay,
     t_max: f32,
+    t_prune: f32,
+    max_reference: u32,
     shadow_target: u32,
 ) -> ClosestPrimitive {
     let nodes = geometry.bvh_nodes;
@@ -104,9 +115,13 @@ pub fn bvh_traverse(
         primitive: PRIMITIVE_QUAD,
         index: 0,
     };
+    let mut best_reference = max_reference;
+    let mut prune = t_prune;
     let mut found = false;
     let root = &nodes[0];
-    if hit_box(root, r, best.t) == NO_HIT {
+    // Where the ray enters the node being entered.
+    let mut node_entry = hit_box(root, r, prune);
+    if node_entry == NO_HIT {
         return ClosestPrimitive {
             t: NO_HIT,
             primitive: PRIMITIVE_QUAD,
@@ -117,8 +132,8 @@ pub fn bvh_traverse(
     // visited. The kernel reads the node again instead, and keeps only node indices on its
     // stack, redoing a popped node's box test: on lavapipe, per-lane memory costs more than
     // that arithmetic, and carrying first and count measured no faster (BENCHMARKS.md). The
-    // decisions are the same: a popped node's entry distance has not changed, only t_max can
-    // have shrunk.
+    // decisions are the same: a popped node's entry distance has not changed, only the bound
+    // can have shrunk.
     let (mut first, mut count) = (root.first, root.count);
     // Far children left for later: what entering them needs, and where the ray enters their box.
     let mut stack = [(0u32, 0u32, 0f32); BVH_STACK_SIZE];
@@ -128,12 +143,18 @@ pub fn bvh_traverse(
             for i in first..first + count {
                 let reference = geometry.bvh_primitives[i as usize];
                 let t = hit_primitive(geometry, reference, r);
-                if t < best.t && reference != shadow_target {
+                // The target is excluded by name too, not only by the rule: a shader compiler
+                // may round its test here and in `bvh_first_hit_is` differently.
+                if hit_comes_first(t, reference, best.t, best_reference)
+                    && reference != shadow_target
+                {
                     best = ClosestPrimitive {
                         t,
                         primitive: reference >> PRIMITIVE_KIND_SHIFT,
                         index: reference & PRIMITIVE_INDEX_MASK,
                     };
+                    best_reference = reference;
+                    prune = t.max(node_entry);
                     found = true;
                     if shadow_target != NO_PRIMITIVE {
                         return best;
@@ -143,35 +164,35 @@ pub fn bvh_traverse(
         } else {
             let left = &nodes[first as usize];
             let right = &nodes[first as usize + 1];
-            let t_left = hit_box(left, r, best.t);
-            let t_right = hit_box(right, r, best.t);
+            let t_left = hit_box(left, r, prune);
+            let t_right = hit_box(right, r, prune);
             if t_left != NO_HIT && t_right != NO_HIT {
-                let (near, far, t_far) = if t_left <= t_right {
-                    (left, right, t_right)
+                let (near, far, t_near, t_far) = if t_left <= t_right {
+                    (left, right, t_left, t_right)
                 } else {
-                    (right, left, t_left)
+                    (right, left, t_right, t_left)
                 };
                 stack[top] = (far.first, far.count, t_far);
                 top += 1;
-                (first, count) = (near.first, near.count);
+                (first, count, node_entry) = (near.first, near.count, t_near);
                 continue;
             }
             if t_left != NO_HIT {
-                (first, count) = (left.first, left.count);
+                (first, count, node_entry) = (left.first, left.count, t_left);
                 continue;
             }
             if t_right != NO_HIT {
-                (first, count) = (right.first, right.count);
+                (first, count, node_entry) = (right.first, right.count, t_right);
                 continue;
             }
         }
-        // Pop the next node that may still hold something nearer than the best hit.
+        // Pop the next node that may still hold something before the best hit.
         let mut popped = false;
         while top > 0 {
             top -= 1;
             let (node_first, node_count, t_entry) = stack[top];
-            if t_entry <= widened(best.t) {
-                (first, count) = (node_first, node_count);
+            if t_entry <= widened(prune) {
+                (first, count, node_entry) = (node_first, node_count, t_entry);
                 popped = true;
                 break;
             }
@@ -186,14 +207,42 @@ pub fn bvh_traverse(
     best
 }
 
+/// Where `r` enters the box of the primitive `reference` (the box the host builds the BVH
+/// over: `primitive_boxes` in src/scene/bvh.rs, the same arithmetic), or `NO_HIT`.
+pub fn primitive_box_entry(geometry: &Geometry, reference: u32, r: &BvhRay) -> f32 {
+    let kind = reference >> PRIMITIVE_KIND_SHIFT;
+    let index = (reference & PRIMITIVE_INDEX_MASK) as usize;
+    let (min, max) = if kind == PRIMITIVE_TRIANGLE {
+        let t = &geometry.triangles[index];
+        let (a, b, c) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
+        (a.min(b).min(c), a.max(b).max(c))
+    } else if kind == PRIMITIVE_QUAD {
+        let q = &geometry.quads[index];
+        let p = Vec3::from(q.corner);
+        let (pu, pv) = (p + Vec3::from(q.edge_u), p + Vec3::from(q.edge_v));
+        let puv = pu + Vec3::from(q.edge_v);
+        (p.min(pu).min(pv).min(puv), p.max(pu).max(pv).max(puv))
+    } else {
+        let s = &geometry.spheres[index];
+        let c = Vec3::from(s.center);
+        (c - s.radius, c + s.radius)
+    };
+    let node = BvhNode {
+        min: min.to_array(),
+        max: max.to_array(),
+        ..Default::default()
+    };
+    hit_box(&node, r, NO_HIT)
+}
+
 pub fn bvh_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
-    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_PRIMITIVE)
+    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_HIT, 0, NO_PRIMITIVE)
 }
 
 /// Whether `ray` hits nothing: a shadow-ray search for any hit, with no target.
 pub fn bvh_escapes(geometry: &Geometry, ray: &Ray) -> bool {
     let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
-    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, no_target).t == NO_HIT
+    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_HIT, 0, no_target).t == NO_HIT
 }
 
 pub fn bvh_first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u32) -> bool {
@@ -203,5 +252,8 @@ pub fn bvh_first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u
     if t_target == NO_HIT {
         return false;
     }
-    bvh_traverse(geometry, &r, t_target, target).t == NO_HIT
+    // Pruned no earlier than where the ray enters the target's own box: a primitive before it
+    // at the same t, a copy of it, is in a box the same as that one.
+    let t_prune = t_target.max(primitive_box_entry(geometry, target, &r));
+    bvh_traverse(geometry, &r, t_target, t_prune, target, target).t == NO_HIT
 }

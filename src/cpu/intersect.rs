@@ -125,10 +125,26 @@ pub struct ClosestPrimitive {
     pub index: u32,
 }
 
+/// The closest-hit rule, the same for every traversal on every device so that any structure
+/// finds the same hit: the smallest t, and among equal t the lowest primitive reference,
+/// `(kind << PRIMITIVE_KIND_SHIFT) | index`, that is spheres first, then quads, then
+/// triangles, each by index. Whether a hit at `t` on `reference` comes before the best so far.
+pub fn hit_comes_first(t: f32, reference: u32, best_t: f32, best_reference: u32) -> bool {
+    t < best_t || (t == best_t && reference < best_reference)
+}
+
 pub fn closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
     if !geometry.bvh_nodes.is_empty() {
         return bvh_closest_primitive(geometry, ray);
     }
+    scan_closest_primitive(geometry, ray)
+}
+
+/// The closest primitive by testing every one: the structure without a BVH, and what every
+/// other traversal must agree with. It visits primitives in the closest-hit rule's order
+/// ([`hit_comes_first`]) and keeps only strictly nearer hits, so among equal t the first, the
+/// lowest reference, wins.
+pub fn scan_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
     let mut best = ClosestPrimitive {
         t: NO_HIT,
         primitive: PRIMITIVE_QUAD,

@@ -1,15 +1,21 @@
 //! Light sampling for next-event estimation (WGSL side: `shaders/lights.wgsl`). An emitter is
 //! chosen in proportion to its power, then a direction towards it: quads and triangles by area, spheres by
 //! the cone of directions they subtend from outside, and by area from inside, the environment
-//! map by luminance (`environment.rs`). All pdfs are per
+//! map by luminance (`environment.rs`), point, spot and directional lights in `punctual.rs`.
+//! All pdfs are per
 //! unit solid angle at the shading point and include the selection probability.
 
 use super::environment::{environment_pdf, sample_environment};
 use super::frame::{basis, PI};
+use super::intersect::first_hit_is;
+use super::punctual::{punctual_visible, sample_punctual};
 use super::rng::Rng;
 use super::trace::SceneRefs;
 use super::triangle::{triangle_normal, triangle_plane_distance, triangle_point};
-use crate::shader_types::{Sphere, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE};
+use super::Ray;
+use crate::shader_types::{
+    Sphere, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
+};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -20,14 +26,36 @@ pub struct LightSample {
     pub radiance: Vec3,
     pub primitive: u32,
     pub index: u32,
+    /// A point, spot or delta sun: no BSDF-sampled ray reaches it, so its MIS weight is 1.
+    pub is_delta: bool,
 }
 
-/// Selection by the emitters' cumulative probabilities.
-pub fn pick_emitter(scene: &SceneRefs, u: f32) -> usize {
-    let count = scene.params.emitter_count as usize;
-    (0..count.saturating_sub(1))
-        .find(|&i| u < scene.emitters[i].cdf)
-        .unwrap_or(count - 1)
+/// The emitter light sampling chose: which primitive, and the probability of choosing it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmitterChoice {
+    pub primitive: u32,
+    pub index: u32,
+    pub probability: f32,
+}
+
+/// Selection in proportion to power, in O(1) by the alias table (`src/scene/kernel.rs`): `u`
+/// picks the slot, `u_alias` its emitter or the alias. The slot is ⌊u·n⌋ in f32 on both
+/// devices (a correctly rounded product, then truncation), so both pick the same emitter.
+pub fn pick_emitter(scene: &SceneRefs, u: f32, u_alias: f32) -> EmitterChoice {
+    let n = scene.params.emitter_count;
+    let slot = &scene.emitters[((u * n as f32) as u32).min(n - 1) as usize];
+    if u_alias < slot.alias_threshold {
+        return EmitterChoice {
+            primitive: slot.primitive,
+            index: slot.index,
+            probability: slot.probability,
+        };
+    }
+    EmitterChoice {
+        primitive: slot.alias_primitive,
+        index: slot.alias_index,
+        probability: slot.alias_probability,
+    }
 }
 
 pub fn sphere_contains(s: &Sphere, p: Vec3) -> bool {
@@ -71,14 +99,19 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         radiance: Vec3::ZERO,
         primitive: 0,
         index: 0,
+        is_delta: false,
     };
     if scene.params.emitter_count == 0 {
         return out;
     }
-    let e = scene.emitters[pick_emitter(scene, rng.next_f32())];
+    let (u_slot, u_alias) = (rng.next_f32(), rng.next_f32());
+    let e = pick_emitter(scene, u_slot, u_alias);
     let u = (rng.next_f32(), rng.next_f32());
     out.primitive = e.primitive;
     out.index = e.index;
+    if e.primitive == PRIMITIVE_LIGHT {
+        return sample_punctual(scene, e.index, e.probability, p, u);
+    }
     if e.primitive == PRIMITIVE_ENVIRONMENT {
         let s = sample_environment(scene, u, rng);
         out.dir = s.dir;
@@ -191,6 +224,23 @@ pub fn light_pdf(
             * area_to_solid_angle(t, cos_exit, 4.0 * PI * s.radius * s.radius);
     }
     s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p))
+}
+
+/// Whether a shadow ray along a light sample reaches the light it sampled.
+pub fn light_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) -> bool {
+    if light.primitive == PRIMITIVE_LIGHT {
+        return punctual_visible(scene, shadow, light);
+    }
+    first_hit_is(&scene.geometry(), shadow, light.primitive, light.index)
+}
+
+/// The MIS weight of a light sample against BSDF sampling, which would have drawn its
+/// direction with `bsdf_pdf`: 1 for delta lights, which BSDF sampling cannot reach.
+pub fn nee_weight(light: &LightSample, bsdf_pdf: f32) -> f32 {
+    if light.is_delta {
+        return 1.0;
+    }
+    power_heuristic(light.pdf, bsdf_pdf)
 }
 
 /// Veach's power heuristic (β = 2) for the sample drawn with pdf `a` against pdf `b`:

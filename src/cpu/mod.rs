@@ -18,6 +18,7 @@ pub mod lights;
 pub mod material;
 pub mod microfacet;
 pub mod pbr;
+pub mod punctual;
 pub mod renderer;
 pub mod rng;
 pub mod shading_normal;

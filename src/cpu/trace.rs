@@ -6,17 +6,18 @@ use super::aov::{
 };
 use super::camera::camera_ray;
 use super::environment::environment_radiance;
-use super::intersect::{crosses_shading_side, first_hit_is, intersect_scene, Geometry, NO_HIT};
-use super::lights::{light_pdf, power_heuristic, sample_light};
+use super::intersect::{crosses_shading_side, intersect_scene, Geometry, NO_HIT};
+use super::lights::{light_pdf, light_visible, nee_weight, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
+use super::punctual::sun_disks_radiance;
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::surface::offset_ray_origin;
 use super::texture::{material_at, Textures};
 use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Material, Params, Quad, Sphere, Texture,
-    Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
+    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
+    Texture, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
 };
 use glam::Vec3;
 
@@ -39,6 +40,8 @@ pub struct SceneRefs<'a> {
     /// Empty without an environment map.
     pub environment_texels: &'a [EnvironmentTexel],
     pub environment_alias: &'a [EnvironmentAlias],
+    /// Point, spot and directional lights (`punctual.rs`).
+    pub lights: &'a [Light],
 }
 
 impl<'a> SceneRefs<'a> {
@@ -59,6 +62,7 @@ impl<'a> SceneRefs<'a> {
             textures: &scene.textures,
             texels: &scene.texels,
             triangle_uvs: &scene.triangle_uvs,
+            lights: &scene.lights,
         }
     }
 
@@ -167,6 +171,11 @@ pub fn path_step(
                 escaped *= power_heuristic(path.bsdf_pdf_of_ray, pdf);
             }
         }
+        // The kernel compiles sun disks in only for scenes that have one (HAS_SUN_DISKS).
+        if params.light_count > 0 {
+            let mis = light_sampling && !path.came_from_delta;
+            escaped += sun_disks_radiance(scene, ray.dir, path.bsdf_pdf_of_ray, mis);
+        }
         path.radiance += firefly_clamp(params, path.throughput * escaped, bounce);
         return true;
     }
@@ -215,9 +224,8 @@ pub fn path_step(
                     dir: light.dir,
                 };
                 *segments += 1;
-                if first_hit_is(&scene.geometry(), &shadow, light.primitive, light.index) {
-                    let weight =
-                        power_heuristic(light.pdf, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
+                if light_visible(scene, &shadow, &light) {
+                    let weight = nee_weight(&light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     let contribution =
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);
                     path.radiance += firefly_clamp(params, contribution, bounce + 1);

@@ -40,15 +40,16 @@ pub fn loop_iterations_per_ray(scene: &KernelScene) -> u64 {
 }
 
 /// The most loop iterations one sample can take: for the camera ray and each scattering event,
-/// a ray and a shadow ray each make at most [`loop_iterations_per_ray`], light sampling loops
-/// over the emitters, and the path loop makes one more.
+/// a ray and a shadow ray each make at most [`loop_iterations_per_ray`], a ray that escapes
+/// looks for sun disks among the lights, and the path loop makes one more (light sampling
+/// picks its emitter from the alias table, without a loop).
 pub fn loop_iterations_per_sample(scene: &KernelScene) -> u64 {
     sample_iterations(&scene.params, loop_iterations_per_ray(scene))
 }
 
 fn sample_iterations(params: &Params, per_ray: u64) -> u64 {
     let segments = params.max_bounces as u64 + 1;
-    segments * (2 * per_ray + params.emitter_count as u64 + 1)
+    segments * (2 * per_ray + params.light_count as u64 + 1)
 }
 
 /// Samples per pixel one dispatch may take on a device with this loop limit, from
@@ -75,10 +76,10 @@ mod tests {
             };
             sample_iterations(&params, spheres as u64 + quads as u64)
         };
-        // The Cornell box: 9 segments of 2 × 10 primitives + 2.
+        // The Cornell box: 9 segments of 2 × 10 primitives + 1.
         assert_eq!(
             max_samples_per_dispatch(params(2, 8, 8), Some(65535)),
-            65535 / 198
+            65535 / 189
         );
         assert_eq!(max_samples_per_dispatch(params(5000, 7, 4), Some(65535)), 1);
         assert_eq!(

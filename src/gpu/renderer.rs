@@ -208,6 +208,7 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.environment_alias),
                     read_only,
                 ),
+                BufferNeed::new("lights", array_bytes(&scene.lights), read_only),
                 BufferNeed::new("accumulation", accum_size, BufferBinding::Storage),
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
@@ -246,6 +247,7 @@ impl<'a> GpuRenderer<'a> {
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
+        let lights = storage_buffer(ctx, "lights", &scene.lights);
         // The PBR material's energy tables (src/ggx_energy.rs), a placeholder without one.
         let ggx_energy: &[f32] = if variant.features.pbr {
             crate::ggx_energy::ggx_energy_table()
@@ -320,7 +322,8 @@ impl<'a> GpuRenderer<'a> {
                 (22, read_only, &triangle_uvs),
                 (18, read_only, &environment_texels),
                 (19, read_only, &environment_alias),
-                (24, read_only, &ggx_energy),
+                (24, read_only, &lights),
+                (25, read_only, &ggx_energy),
             ],
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {

@@ -63,6 +63,8 @@ pub(super) struct SceneToml {
     #[serde(default)]
     pub(super) meshes: Vec<S<MeshToml>>,
     pub(super) environment: Option<S<EnvironmentToml>>,
+    #[serde(default)]
+    pub(super) lights: Vec<S<LightToml>>,
 }
 
 #[derive(Deserialize)]
@@ -160,4 +162,20 @@ pub(super) struct EnvironmentToml {
     pub(super) strength: Option<S<Real>>,
     /// Degrees about the up (+y) axis.
     pub(super) rotate: Option<S<Real>>,
+}
+
+/// `[[lights]]`: a point, spot or directional light (`src/scene/light.rs`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LightToml {
+    #[serde(rename = "type")]
+    pub(super) kind: S<String>,
+    pub(super) position: Option<S<Triple>>,
+    pub(super) direction: Option<S<Triple>>,
+    pub(super) color: Option<S<Triple>>,
+    pub(super) intensity: S<Real>,
+    pub(super) inner_angle: Option<S<Real>>,
+    pub(super) outer_angle: Option<S<Real>>,
+    pub(super) angle: Option<S<Real>>,
+    pub(super) radius: Option<S<Real>>,
 }

@@ -5,8 +5,12 @@
 //! Colour in 8- and 16-bit formats (PNG, JPEG) is sRGB-encoded by convention and is decoded
 //! with the sRGB transfer function when the caller reads colour; data such as roughness is
 //! stored linearly. Float formats (EXR, Radiance HDR) hold linear values and are never
-//! decoded.
+//! decoded. Every compression the `exr` crate reads is accepted (all OpenEXR writes but
+//! HTJ2K, LJ2K and ZSTD, which are refused by name); lossy ones (DWAA, DWAB, B44, PXR24)
+//! leave small negative values near black, which are set to 0 and reported (see
+//! [`ClampedNegatives`]).
 
+use crate::exr_header;
 use crate::input_file::{format_size, read_regular_file, IMAGE_FILE_LIMIT};
 use std::io::Cursor;
 use std::path::Path;
@@ -31,6 +35,32 @@ pub struct LinearImage {
     pub width: u32,
     pub height: u32,
     pub texels: Vec<[f32; 3]>,
+    /// Negative values the file held, now 0.
+    pub clamped: Option<ClampedNegatives>,
+}
+
+/// Negative values in a float image (EXR, HDR), set to 0 on load. Lossy EXR compression leaves
+/// them near black (Blender's own `forest.exr`, DWAB, holds 784, down to −1.6·10⁻³, beside
+/// texels up to 1010): noise, not light, so they are clamped with a warning, not refused. NaN and infinite values are
+/// not clamped; the callers refuse them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClampedNegatives {
+    /// Channel values clamped (up to 3 per texel).
+    pub count: u64,
+    pub most_negative: f32,
+}
+
+impl ClampedNegatives {
+    /// One line for a warning, after the file's name.
+    pub fn warning(&self) -> String {
+        format!(
+            "{} negative value{} (the most negative {:e}) set to 0; lossy EXR compression leaves \
+             such values near black",
+            self.count,
+            if self.count == 1 { "" } else { "s" },
+            self.most_negative
+        )
+    }
 }
 
 impl LinearImage {
@@ -81,7 +111,7 @@ pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage,
     }
     let (width, height) = reader
         .into_dimensions()
-        .map_err(|e| format!("cannot decode the image: {e}"))?;
+        .map_err(|e| decode_error(e, &bytes, format))?;
     if width == 0 || height == 0 {
         return Err(format!(
             "the image is {width}×{height}; it must have texels"
@@ -99,11 +129,11 @@ pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage,
     reader.set_format(format);
     let decoded = reader
         .decode()
-        .map_err(|e| format!("cannot decode the image: {e}"))?;
+        .map_err(|e| decode_error(e, &bytes, format))?;
     let rgb = decoded.to_rgb32f();
     // to_rgb32f maps integer texels to [0, 1] linearly; the transfer function is ours to apply.
     let decode_srgb = encoding == Encoding::Srgb && !is_float_format(format);
-    let texels = rgb
+    let mut texels: Vec<[f32; 3]> = rgb
         .pixels()
         .map(|p| {
             if decode_srgb {
@@ -117,16 +147,64 @@ pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage,
             }
         })
         .collect();
+    let clamped = clamp_negatives(&mut texels);
     Ok(LinearImage {
         width,
         height,
         texels,
+        clamped,
+    })
+}
+
+/// The decoder's error as a sentence. For an EXR whose compression the `exr` crate cannot read
+/// (HTJ2K, ZSTD), it names the compression, which the crate's own message may not.
+fn decode_error(e: image::ImageError, bytes: &[u8], format: image::ImageFormat) -> String {
+    if format == image::ImageFormat::OpenExr {
+        if let Some(compression) = exr_header::compression(bytes)
+            .filter(|c| !exr_header::READABLE_COMPRESSIONS.contains(&c.as_str()))
+        {
+            return format!(
+                "cannot decode the image: its EXR compression, {compression}, is not one glint \
+                 reads ({})",
+                exr_header::READABLE_COMPRESSIONS.join(", ")
+            );
+        }
+    }
+    format!("cannot decode the image: {e}")
+}
+
+/// Sets every finite negative value to 0 and says how many there were; −∞ and NaN stay.
+fn clamp_negatives(texels: &mut [[f32; 3]]) -> Option<ClampedNegatives> {
+    let mut count = 0u64;
+    let mut most_negative = 0.0f32;
+    for c in texels.iter_mut().flatten() {
+        if *c < 0.0 && c.is_finite() {
+            count += 1;
+            most_negative = most_negative.min(*c);
+            *c = 0.0;
+        }
+    }
+    (count > 0).then_some(ClampedNegatives {
+        count,
+        most_negative,
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn finite_negatives_are_clamped_and_counted() {
+        let mut texels = [[1.0, -4.5e-6, 0.0], [-1e-3, f32::NAN, f32::NEG_INFINITY]];
+        let clamped = clamp_negatives(&mut texels).unwrap();
+        assert_eq!(clamped.count, 2);
+        assert_eq!(clamped.most_negative, -1e-3);
+        assert_eq!(texels[0], [1.0, 0.0, 0.0]);
+        assert_eq!(texels[1][0], 0.0);
+        assert!(texels[1][1].is_nan() && texels[1][2] == f32::NEG_INFINITY);
+        assert_eq!(clamp_negatives(&mut [[0.0, 1.0, 2.0]]), None);
+    }
 
     #[test]
     fn srgb_decoding_matches_the_standard_at_known_points() {

@@ -3,12 +3,14 @@
 
 use super::bvh;
 use super::environment;
+use super::light::LightKind;
 use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
     TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR,
-    MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE,
     PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::Vec3;
@@ -37,6 +39,9 @@ pub struct KernelScene {
     /// The environment map's texels and alias table (`environment.rs`); empty without one.
     pub environment_texels: Vec<EnvironmentTexel>,
     pub environment_alias: Vec<EnvironmentAlias>,
+    /// Point, spot and directional lights (`scene::light`); point lights with a radius are
+    /// spheres instead.
+    pub lights: Vec<shader_types::Light>,
 }
 
 impl KernelScene {
@@ -58,6 +63,7 @@ impl KernelScene {
             + bytes(&self.triangle_uvs)
             + bytes(&self.environment_texels)
             + bytes(&self.environment_alias)
+            + bytes(&self.lights)
     }
 }
 
@@ -91,16 +97,52 @@ impl Scene {
     }
 
     /// Converts to the kernel's structs (camera basis precomputed, quads' duals, emission ×
-    /// strength, the BVH). Fails (bad input) when the BVH is deeper than the traversal stack.
+    /// strength, the BVH). Fails (bad input) when there are more primitives than the BVH can
+    /// reference.
     pub fn try_kernel_scene(&self) -> Result<KernelScene, InputError> {
+        if self.lights.iter().any(|l| l.sphere().is_some()) {
+            return self.with_sphere_lights().lay_out();
+        }
+        self.lay_out()
+    }
+
+    /// The scene with each point light that has a radius turned into an emitting sphere, with
+    /// a material of its own (`lights[i]`), which the kernel traces like any other sphere.
+    fn with_sphere_lights(&self) -> Scene {
+        let mut scene = self.clone();
+        scene.lights.clear();
+        for (i, light) in self.lights.iter().enumerate() {
+            let Some((center, radius, radiance)) = light.sphere() else {
+                scene.lights.push(light.clone());
+                continue;
+            };
+            scene.spheres.push(super::Sphere {
+                center,
+                radius,
+                material: scene.materials.len() as u32,
+            });
+            scene.materials.push(super::Material {
+                name: format!("lights[{i}]"),
+                kind: MaterialKind::Diffuse,
+                color: Vec3::ZERO,
+                emitted_radiance: radiance,
+                color_texture: None,
+                roughness_texture: None,
+            });
+        }
+        scene
+    }
+
+    fn lay_out(&self) -> Result<KernelScene, InputError> {
         let r = &self.render;
         let environment = self.environment.as_ref().map(|e| (e, e.tables()));
-        let (
+        let EmitterTable {
             emitters,
-            sphere_light_probability,
-            quad_light_probability,
-            triangle_light_probability,
-        ) = self.emitter_table(environment.as_ref().map(|(_, t)| t.radiance_integral));
+            sphere_probability: sphere_light_probability,
+            quad_probability: quad_light_probability,
+            triangle_probability: triangle_light_probability,
+            light_probability,
+        } = self.emitter_table(environment.as_ref().map(|(_, t)| t.radiance_integral));
         let (environment_cos, environment_sin) = environment
             .as_ref()
             .map_or((1.0, 0.0), |(e, _)| e.rotation());
@@ -134,7 +176,7 @@ impl Scene {
                 .iter()
                 .find(|e| e.primitive == PRIMITIVE_ENVIRONMENT)
                 .map_or(0.0, |e| e.probability),
-            pad4: 0,
+            light_count: self.lights.len() as u32,
             ..Default::default()
         };
         place_camera(&mut params, &self.camera);
@@ -265,6 +307,12 @@ impl Scene {
             },
             environment_texels: Vec::new(),
             environment_alias: Vec::new(),
+            lights: self
+                .lights
+                .iter()
+                .zip(light_probability)
+                .map(|(l, p)| l.kernel_light(p))
+                .collect(),
         };
         if let Some((_, tables)) = environment {
             scene.environment_texels = tables.texels;
@@ -275,8 +323,8 @@ impl Scene {
             scene.quads.len(),
             scene.triangles.len(),
         ) {
-            // Validation bounds the primitive count far below what a reference holds; a tree
-            // deeper than the traversal stack (rare with PLOC) is refused.
+            // Validation bounds the primitive count far below what a reference holds, and the
+            // builder bounds the tree's depth by the traversal stack: this error is a backstop.
             let tree = bvh::build(&scene.spheres, &scene.quads, &scene.triangles)
                 .map_err(|e| InputError(format!("the scene cannot be rendered: {e}")))?;
             scene.bvh_nodes = tree.nodes;
@@ -287,15 +335,13 @@ impl Scene {
     }
 
     /// Every emitting primitive with its selection probability, proportional to its power
-    /// (mean emitted radiance × area; the factor π is common to all), and that probability per
+    /// (mean emitted radiance × area; the factor π is common to all), as Vose's alias table
+    /// (the environment map's, [`environment::alias_table`]), and that probability per
     /// sphere, per quad and per triangle (0 for those that do not emit). The environment map,
     /// given its ∫ L dω, emits that through a disc the size of the scene: π R² ∫ L dω, whose π
-    /// is dropped as for the others (pbrt's ImageInfiniteLight::Phi).
-    #[allow(clippy::type_complexity)]
-    fn emitter_table(
-        &self,
-        environment_radiance_integral: Option<f64>,
-    ) -> (Vec<Emitter>, Vec<f32>, Vec<f32>, Vec<f32>) {
+    /// is dropped as for the others (pbrt's ImageInfiniteLight::Phi); so does a sun
+    /// (`Light::power`).
+    fn emitter_table(&self, environment_radiance_integral: Option<f64>) -> EmitterTable {
         let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
         let mut powers: Vec<(u32, u32, f64)> = Vec::new();
         for (i, s) in self.spheres.iter().enumerate() {
@@ -323,7 +369,12 @@ impl Scene {
                 powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }
         }
-        if let Some(integral) = environment_radiance_integral {
+        let has_sun = self
+            .lights
+            .iter()
+            .any(|l| matches!(l.kind, LightKind::Directional { .. }));
+        let mut scene_radius = 1.0;
+        if environment_radiance_integral.is_some() || has_sun {
             let points = self
                 .spheres
                 .iter()
@@ -341,46 +392,76 @@ impl Scene {
                         q.corner + q.u + q.v,
                     ]
                 }))
-                .chain(self.triangles.iter().flat_map(|t| t.vertices));
-            let power = environment::scene_radius(points).powi(2) * integral;
+                .chain(self.triangles.iter().flat_map(|t| t.vertices))
+                .chain(self.lights.iter().filter_map(|l| match l.kind {
+                    LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                        Some(position)
+                    }
+                    LightKind::Directional { .. } => None,
+                }));
+            scene_radius = environment::scene_radius(points);
+        }
+        if let Some(integral) = environment_radiance_integral {
+            let power = scene_radius.powi(2) * integral;
             if power > 0.0 {
                 powers.push((PRIMITIVE_ENVIRONMENT, 0, power));
             }
         }
+        for (i, l) in self.lights.iter().enumerate() {
+            let power = l.power(scene_radius);
+            if power > 0.0 {
+                powers.push((PRIMITIVE_LIGHT, i as u32, power));
+            }
+        }
         let total: f64 = powers.iter().map(|p| p.2).sum();
-        let mut cumulative = 0.0;
         let mut emitters: Vec<Emitter> = powers
             .iter()
-            .map(|&(primitive, index, power)| {
-                cumulative += power / total;
-                Emitter {
-                    primitive,
-                    index,
-                    cdf: cumulative as f32,
-                    probability: (power / total) as f32,
-                }
+            .map(|&(primitive, index, power)| Emitter {
+                primitive,
+                index,
+                probability: (power / total) as f32,
+                ..Default::default()
             })
             .collect();
-        if let Some(last) = emitters.last_mut() {
-            last.cdf = 1.0;
+        let weights: Vec<f64> = powers.iter().map(|p| p.2).collect();
+        for (slot, alias) in environment::alias_table(&weights).iter().enumerate() {
+            let other = emitters[alias.alias_texel as usize];
+            let e = &mut emitters[slot];
+            e.alias_threshold = alias.threshold;
+            e.alias_primitive = other.primitive;
+            e.alias_index = other.index;
+            e.alias_probability = other.probability;
         }
         let mut sphere_probability = vec![0.0; self.spheres.len()];
         let mut quad_probability = vec![0.0; self.quads.len()];
         let mut triangle_probability = vec![0.0; self.triangles.len()];
+        let mut light_probability = vec![0.0; self.lights.len()];
         for e in &emitters {
             let per_primitive = match e.primitive {
                 PRIMITIVE_SPHERE => &mut sphere_probability,
                 PRIMITIVE_QUAD => &mut quad_probability,
                 PRIMITIVE_TRIANGLE => &mut triangle_probability,
+                PRIMITIVE_LIGHT => &mut light_probability,
                 _ => continue,
             };
             per_primitive[e.index as usize] = e.probability;
         }
-        (
+        EmitterTable {
             emitters,
             sphere_probability,
             quad_probability,
             triangle_probability,
-        )
+            light_probability,
+        }
     }
+}
+
+/// The emitters (light sampling's alias table), and the probability of picking each sphere,
+/// quad, triangle and light (0 for those that do not emit).
+struct EmitterTable {
+    emitters: Vec<Emitter>,
+    sphere_probability: Vec<f32>,
+    quad_probability: Vec<f32>,
+    triangle_probability: Vec<f32>,
+    light_probability: Vec<f32>,
 }

@@ -12,6 +12,7 @@ pub mod environment;
 mod file;
 pub mod image;
 mod kernel;
+pub mod light;
 pub mod limits;
 pub mod mesh;
 pub mod stress;
@@ -80,6 +81,8 @@ pub struct Scene {
     pub textures: texture::TextureSet,
     /// `[environment]`: lights the scene in place of `render.background`.
     pub environment: Option<environment::Environment>,
+    /// `[[lights]]`: point, spot and directional lights.
+    pub lights: Vec<light::Light>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

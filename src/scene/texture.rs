@@ -29,6 +29,9 @@ pub struct TextureSet {
     pub texels: Vec<[f32; 4]>,
     /// Images already loaded, by canonical path and use.
     loaded: HashMap<(PathBuf, TextureUse), u32>,
+    /// Warning lines from loading (negative texels clamped), each naming its file; the scene
+    /// takes them when it is validated.
+    pub warnings: Vec<String>,
 }
 
 impl TextureSet {
@@ -51,6 +54,10 @@ impl TextureSet {
             TextureUse::Roughness => Encoding::Linear,
         };
         let image = load_linear_image(path, encoding)?;
+        if let Some(clamped) = image.clamped {
+            self.warnings
+                .push(format!("{}: {}", path.display(), clamped.warning()));
+        }
         let channels = match usage {
             TextureUse::Color => 3,
             TextureUse::Roughness => 1,

@@ -5,7 +5,9 @@ use glint::gpu::binding::{compute_bind_group, compute_pipeline};
 use glint::gpu::renderer::storage_buffer;
 use glint::gpu::GpuContext;
 use glint::scene::KernelScene;
-use glint::shader::render_kernel_source;
+use glint::shader::{
+    render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
+};
 use wgpu::util::DeviceExt;
 
 /// The probe kernel's parameters (tests/shaders/probe.wgsl).
@@ -38,10 +40,39 @@ pub fn run_probe(
     params: ProbeParams,
     scene: &KernelScene,
 ) -> Vec<[f32; 4]> {
+    run_probe_source(ctx, entry, params, scene, probe_module_source())
+}
+
+/// [`run_probe`] in the kernel variant that traverses `scene`'s BVH (which it must have), with
+/// the BVH's root alone in the uniform copy of its top.
+pub fn run_probe_bvh(
+    ctx: &GpuContext,
+    entry: &str,
+    params: ProbeParams,
+    scene: &KernelScene,
+) -> Vec<[f32; 4]> {
+    let variant = KernelVariant {
+        binding: SceneBinding::Bvh {
+            uniform_nodes: 1,
+            stack_size: glint::scene::bvh::kernel_stack_size(&scene.bvh_nodes),
+        },
+        features: KernelFeatures::ALL,
+    };
+    let source = render_kernel_source_for(variant) + PROBE_SOURCE;
+    run_probe_source(ctx, entry, params, scene, source)
+}
+
+fn run_probe_source(
+    ctx: &GpuContext,
+    entry: &str,
+    params: ProbeParams,
+    scene: &KernelScene,
+    source: String,
+) -> Vec<[f32; 4]> {
     let device = &ctx.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("probe"),
-        source: wgpu::ShaderSource::Wgsl(probe_module_source().into()),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let uniform = |bytes: &[u8]| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -69,6 +100,7 @@ pub fn run_probe(
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
+    let lights = storage_buffer(ctx, "lights", &scene.lights);
     let ggx_energy = storage_buffer(ctx, "GGX energy", glint::ggx_energy::ggx_energy_table());
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
@@ -107,7 +139,8 @@ pub fn run_probe(
             (22, read_only, &triangle_uvs),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
-            (24, read_only, &ggx_energy),
+            (24, read_only, &lights),
+            (25, read_only, &ggx_energy),
         ],
     );
     let pipeline = compute_pipeline(device, entry, &layout, &module, entry);

@@ -115,3 +115,69 @@ fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
     let uv = triangle_uv(id.x, vec3<f32>(1.0, 0.0, 0.0));
     probe_out[id.x] = vec4<f32>(texture_lookup(probe.seed, uv), 0.0);
 }
+
+// The emitter choice alone (pick_emitter, from the draws sample_light makes first): the
+// chosen primitive, its index and the probability reported for it.
+@compute @workgroup_size(256, 1, 1)
+fn probe_emitter_choice(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let u_slot = rng_next(&rng);
+    let u_alias = rng_next(&rng);
+    let e = pick_emitter(u_slot, u_alias);
+    probe_out[id.x] = vec4<f32>(f32(e.primitive), f32(e.index), e.probability, 0.0);
+}
+
+// The closest-hit rule (tests/closest_hit.rs): rays from points within probe.alpha / 2 per axis
+// of probe.position, aimed at random points of random spheres, quads and triangles (or anywhere),
+// each traced by the BVH and by the scan of every primitive. Needs the BVH kernel variant.
+// Writes, per ray, two entries: the BVH's closest hit (t, kind, index, as bits) and flags, then
+// the scan's closest hit and 0. The flags: 1 when the BVH's shadow test finds the scan's hit
+// first, 2 when it finds a later primitive of its kind (probe.normal[kind] further on: the next
+// copy in a scene of copies) first, 4 when the BVH
+// finds that the ray escapes.
+@compute @workgroup_size(256, 1, 1)
+fn probe_closest_hit(@builtin(global_invocation_id) id: vec3<u32>) {
+    if 2u * id.x + 1u >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    let box = vec3<f32>(rng_next(&rng), rng_next(&rng), rng_next(&rng)) - vec3<f32>(0.5);
+    let origin = probe.position + probe.alpha * box;
+    let pick = rng_next(&rng);
+    let a = rng_next(&rng);
+    let b = rng_next(&rng);
+    let offset = vec3<f32>(rng_next(&rng), rng_next(&rng), rng_next(&rng)) - vec3<f32>(0.5);
+    var aim = probe.position + probe.alpha * offset;
+    let kind = id.x % 4u;
+    if kind == 1u && sphere_count() > 0u {
+        let s = spheres[min(u32(pick * f32(sphere_count())), sphere_count() - 1u)];
+        aim = s.center + 2.0 * s.radius * offset;
+    } else if kind == 2u && quad_count() > 0u {
+        let q = quads[min(u32(pick * f32(quad_count())), quad_count() - 1u)];
+        aim = q.corner + a * q.edge_u + b * q.edge_v;
+    } else if kind == 3u && triangle_count() > 0u {
+        let t = triangles[min(u32(pick * f32(triangle_count())), triangle_count() - 1u)];
+        aim = select(mix(t.v0, t.v1, a), t.v2, b < 0.25);
+    }
+    let ray = Ray(origin, normalize(aim - origin));
+    let found = bvh_closest_primitive(ray);
+    let expected = scan_closest_primitive(ray);
+    var flags = 0u;
+    if expected.t != NO_HIT && bvh_first_hit_is(ray, expected.primitive, expected.index) {
+        flags |= 1u;
+    }
+    let kind_count = select(select(triangle_count(), quad_count(), expected.primitive == PRIMITIVE_QUAD), sphere_count(), expected.primitive == PRIMITIVE_SPHERE);
+    let stride = u32(probe.normal[min(expected.primitive, 2u)]);
+    let next = expected.index + stride;
+    if expected.t != NO_HIT && next < kind_count && bvh_first_hit_is(ray, expected.primitive, next) {
+        flags |= 2u;
+    }
+    if bvh_escapes(ray) {
+        flags |= 4u;
+    }
+    probe_out[2u * id.x] = vec4<f32>(found.t, bitcast<f32>(found.primitive), bitcast<f32>(found.index), f32(flags));
+    probe_out[2u * id.x + 1u] = vec4<f32>(expected.t, bitcast<f32>(expected.primitive), bitcast<f32>(expected.index), 0.0);
+}

@@ -1,44 +1,529 @@
-//! glTF 2.0 files (`.gltf` with external or embedded buffers, binary `.glb`), read by the
-//! `gltf` crate: the default scene's node hierarchy, triangle-list primitives and their
-//! materials.
+//! glTF 2.0 files (`.gltf` with external or embedded buffers, binary `.glb`): the default
+//! scene's node hierarchy, triangle-list primitives and their materials.
+//!
+//! Nothing in the file is trusted before it is checked. The `gltf` crate only parses the JSON
+//! and splits a `.glb`; its validation and its accessor reader are not used (both panic on some
+//! malformed files, and its reader allocates whatever a sparse accessor's `count` says). Here,
+//! before any vertex is read: every index the reader follows is in range; each buffer is read
+//! like the mesh file itself (a regular file within the size limit, see `src/input_file.rs`)
+//! and its `byteLength` checked against the bytes read; each buffer view lies inside its
+//! buffer; each accessor's elements (offset, stride, count, sparse entries) lie inside its
+//! buffer view; the node hierarchy is a set of trees (no cycles, one parent at most), so each
+//! node is visited once; and the triangles the nodes place and the data decoded stay within
+//! bounds set by the file's real size. Each error names the element (`accessors[3]`).
 
-use super::{check_emission, check_reflectance, one_line, read_mesh_bytes, MeshFile, MeshPart};
+use super::{
+    check_emission, check_ior, check_reflectance, one_line, read_mesh_bytes, Geometry, MeshFile,
+    MeshPart, MAX_TRIANGLES,
+};
+use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Material, MaterialKind};
-use glam::{Mat3, Mat4, Vec2, Vec3};
-use std::path::Path;
+use base64::Engine as _;
+use glam::{Mat4, Quat, Vec2, Vec3};
+use gltf::json;
+use json::accessor::{ComponentType, Type};
+use json::mesh::{Mode, Semantic};
+use json::validation::Checked;
+use std::collections::hash_map::{Entry, HashMap};
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
-/// glTF `pbrMetallicRoughness`: baseColorFactor; metallicFactor ≥ 0.5 → metal with
+/// Extensions a file may require: glint reads them (the material ones in part, see README.md).
+const REQUIRABLE_EXTENSIONS: &[&str] = &[
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_mesh_quantization",
+];
+
+/// Extensions glint reads entirely; any other the file uses gets a warning.
+const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization"];
+
+/// Decoded vertex data may reach this many bytes per byte of the file's buffers (plus
+/// [`DECODE_SLACK`]): a byte index becomes a u32, a byte normal component an f32. It bounds
+/// memory when accessors overlap or a sparse accessor has no buffer view.
+const DECODE_RATIO: u64 = 4;
+const DECODE_SLACK: u64 = 1 << 20;
+
+pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
+    let bytes = read_mesh_bytes(path)?;
+    // The gltf crate subtracts the header's 12 bytes from a .glb's declared length unchecked.
+    if bytes.starts_with(b"glTF")
+        && bytes
+            .get(8..12)
+            .is_none_or(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]) < 12)
+    {
+        return Err(
+            "malformed glTF: the .glb header is cut short or declares under 12 bytes".into(),
+        );
+    }
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| format!("malformed glTF: {}", one_line(&e.to_string())))?;
+    drop(bytes);
+    let gltf::Gltf { document, blob } = gltf;
+    let root = document.into_json();
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut warnings = Vec::new();
+    check_extensions(&root, &mut warnings)?;
+    check_references(&root)?;
+    let buffers = read_buffers(&root, blob, dir)?;
+    check_buffer_views(&root, &buffers)?;
+    let instances = instances(&root)?;
+
+    let mut materials = Vec::new();
+    let mut color_textures = Vec::new();
+    let mut has_other_textures = false;
+    for (i, m) in root.materials.iter().enumerate() {
+        let (material, color_texture, other_textures) = material(&root, m, i, dir)?;
+        materials.push(material);
+        color_textures.push(color_texture);
+        has_other_textures |= other_textures;
+    }
+
+    // Every primitive the scene places is checked before any is read, and the triangles
+    // counted: a small file must not make the instances' triangles exceed glint's limit. A
+    // primitive counts as one triangle at least, which bounds the parts made too.
+    let mut plans: HashMap<usize, Vec<PrimitivePlan>> = HashMap::new();
+    let mut triangles = 0u64;
+    for instance in &instances {
+        let plan = match plans.entry(instance.mesh) {
+            Entry::Occupied(plan) => plan.into_mut(),
+            Entry::Vacant(slot) => slot.insert(mesh_plan(&root, &buffers, instance.mesh)?),
+        };
+        triangles += plan.iter().map(|p| p.triangles.max(1)).sum::<u64>();
+        if triangles > MAX_TRIANGLES as u64 {
+            return Err(format!(
+                "nodes[{}]: the scene's nodes place more than {MAX_TRIANGLES} triangles, glint's limit",
+                instance.node
+            ));
+        }
+    }
+
+    let mut decoder = Decoder {
+        root: &root,
+        buffers: &buffers,
+        budget: DECODE_RATIO * buffers.total + DECODE_SLACK,
+    };
+    let mut geometries: HashMap<(usize, usize), Rc<Geometry>> = HashMap::new();
+    let mut parts = Vec::new();
+    for instance in &instances {
+        for (p, plan) in plans[&instance.mesh].iter().enumerate() {
+            let key = (instance.mesh, p);
+            let geometry = match geometries.get(&key) {
+                Some(g) => g.clone(),
+                None => {
+                    let g = Rc::new(decoder.geometry(plan)?);
+                    geometries.insert(key, g.clone());
+                    g
+                }
+            };
+            parts.push(MeshPart {
+                geometry,
+                transform: instance.transform,
+                material: plan.material,
+                name: format!("meshes[{}].primitives[{p}]", instance.mesh),
+            });
+        }
+    }
+    Ok(MeshFile {
+        parts,
+        materials,
+        color_textures,
+        has_other_textures,
+        warnings,
+    })
+}
+
+/// A required extension glint does not read is an error; extensions used get one warning.
+fn check_extensions(root: &json::Root, warnings: &mut Vec<String>) -> Result<(), String> {
+    for (i, name) in root.extensions_required.iter().enumerate() {
+        if !REQUIRABLE_EXTENSIONS.contains(&name.as_str()) {
+            return Err(format!(
+                "extensionsRequired[{i}]: the file requires {name}, which glint does not support \
+                 (it reads {})",
+                REQUIRABLE_EXTENSIONS.join(", ")
+            ));
+        }
+    }
+    let mut partly: Vec<&str> = root
+        .extensions_used
+        .iter()
+        .map(String::as_str)
+        .filter(|e| !FULLY_READ_EXTENSIONS.contains(e))
+        .collect();
+    partly.sort_unstable();
+    partly.dedup();
+    if !partly.is_empty() {
+        warnings.push(format!(
+            "uses glTF extensions that glint reads in part or not at all: {}",
+            partly.join(", ")
+        ));
+    }
+    Ok(())
+}
+
+/// "accessor 99 does not exist (the file has 4)", when `index` is out of range.
+fn exists(index: usize, len: usize, kind: &str) -> Result<usize, String> {
+    if index < len {
+        Ok(index)
+    } else {
+        let plural = match (len, kind) {
+            (1, _) => "",
+            (_, "mesh") => "es",
+            _ => "s",
+        };
+        Err(format!(
+            "{kind} {index} does not exist (the file has {len} {kind}{plural})"
+        ))
+    }
+}
+
+/// The references between buffers, views, accessors and images, checked once so that the
+/// rest can index freely.
+fn check_references(root: &json::Root) -> Result<(), String> {
+    let views = root.buffer_views.len();
+    for (i, view) in root.buffer_views.iter().enumerate() {
+        exists(view.buffer.value(), root.buffers.len(), "buffer")
+            .map_err(|e| format!("bufferViews[{i}].buffer: {e}"))?;
+    }
+    for (i, a) in root.accessors.iter().enumerate() {
+        if let Some(v) = a.buffer_view {
+            exists(v.value(), views, "buffer view")
+                .map_err(|e| format!("accessors[{i}].bufferView: {e}"))?;
+        }
+        if let Some(s) = &a.sparse {
+            exists(s.indices.buffer_view.value(), views, "buffer view")
+                .map_err(|e| format!("accessors[{i}].sparse.indices.bufferView: {e}"))?;
+            exists(s.values.buffer_view.value(), views, "buffer view")
+                .map_err(|e| format!("accessors[{i}].sparse.values.bufferView: {e}"))?;
+        }
+    }
+    for (i, image) in root.images.iter().enumerate() {
+        if let Some(v) = image.buffer_view {
+            exists(v.value(), views, "buffer view")
+                .map_err(|e| format!("images[{i}].bufferView: {e}"))?;
+        }
+    }
+    for (i, texture) in root.textures.iter().enumerate() {
+        exists(texture.source.value(), root.images.len(), "image")
+            .map_err(|e| format!("textures[{i}].source: {e}"))?;
+    }
+    Ok(())
+}
+
+/// Every buffer's bytes, each read once and cut to its `byteLength` (which must not exceed
+/// what was read). External files go through the same checks as the mesh file, and all
+/// buffers together stay within the mesh file limit.
+fn read_buffers(
+    root: &json::Root,
+    mut blob: Option<Vec<u8>>,
+    dir: &Path,
+) -> Result<Buffers, String> {
+    let declared = root
+        .buffers
+        .iter()
+        .fold(0u64, |sum, b| sum.saturating_add(b.byte_length.0));
+    if declared > MESH_FILE_LIMIT {
+        return Err(format!(
+            "buffers: their byteLengths add up to {declared} bytes, more than glint's limit of {} \
+             for a mesh file",
+            format_size(MESH_FILE_LIMIT)
+        ));
+    }
+    let mut buffers = Vec::with_capacity(root.buffers.len());
+    for (i, buffer) in root.buffers.iter().enumerate() {
+        let mut data = match &buffer.uri {
+            Some(uri) => read_uri(uri, dir, "buffer file").map_err(|e| format!("buffers[{i}]: {e}"))?,
+            // Only the first buffer may be the .glb's binary chunk.
+            None if i == 0 => blob.take().ok_or_else(|| {
+                "buffers[0]: no uri, and the file has no binary chunk (a .glb's BIN) to stand for it"
+                    .to_string()
+            })?,
+            None => {
+                return Err(format!(
+                    "buffers[{i}]: no uri; only buffers[0] may be a .glb's binary chunk"
+                ))
+            }
+        };
+        let length = buffer.byte_length.0;
+        if (data.len() as u64) < length {
+            return Err(format!(
+                "buffers[{i}]: byteLength is {length}, but its data holds only {} bytes",
+                data.len()
+            ));
+        }
+        data.truncate(length as usize);
+        data.shrink_to_fit();
+        buffers.push(data);
+    }
+    Ok(Buffers {
+        total: buffers.iter().map(|b| b.len() as u64).sum(),
+        data: buffers,
+    })
+}
+
+/// The file's buffers, each cut to its `byteLength`.
+struct Buffers {
+    data: Vec<Vec<u8>>,
+    /// Their bytes together, which bound what may be decoded from them.
+    total: u64,
+}
+
+/// The bytes a URI names: a base64 `data:` URI, a `file:` URI, or a path relative to the glTF
+/// file's folder (percent-decoded, as URIs are). `what` names the file in messages.
+fn read_uri(uri: &str, dir: &Path, what: &str) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let Some((_, data)) = rest.split_once(";base64,") else {
+            return Err("a data: URI that is not base64".to_string());
+        };
+        return base64::engine::general_purpose::STANDARD
+            .decode(data)
+            .map_err(|e| format!("malformed base64 in the data: URI: {e}"));
+    }
+    let path = resolve_uri(uri, dir)?;
+    read_regular_file(&path, MESH_FILE_LIMIT, what).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The file a (non-`data:`) URI names.
+fn resolve_uri(uri: &str, dir: &Path) -> Result<PathBuf, String> {
+    let rest = match uri
+        .strip_prefix("file://")
+        .or_else(|| uri.strip_prefix("file:"))
+    {
+        Some(rest) => rest,
+        None if uri.contains(':') => {
+            return Err(format!(
+                "URI {uri:?}: only relative paths, file: and data: URIs are read"
+            ))
+        }
+        None => uri,
+    };
+    let decoded = urlencoding::decode(rest)
+        .map_err(|_| format!("URI {uri:?}: its percent-encoding is not UTF-8"))?;
+    Ok(dir.join(&*decoded))
+}
+
+fn check_buffer_views(root: &json::Root, buffers: &Buffers) -> Result<(), String> {
+    for (i, view) in root.buffer_views.iter().enumerate() {
+        let b = view.buffer.value();
+        let offset = view.byte_offset.map_or(0, |o| o.0);
+        let length = view.byte_length.0;
+        let available = buffers.data[b].len() as u64;
+        if offset.checked_add(length).is_none_or(|end| end > available) {
+            return Err(format!(
+                "bufferViews[{i}]: byteOffset {offset} + byteLength {length} run past the end of \
+                 buffers[{b}] ({available} bytes)"
+            ));
+        }
+        if let Some(stride) = view.byte_stride {
+            if !(4..=252).contains(&stride.0) || stride.0 % 4 != 0 {
+                return Err(format!(
+                    "bufferViews[{i}]: byteStride {} must be a multiple of 4 in [4, 252]",
+                    stride.0
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A mesh placed by a node.
+struct Instance {
+    node: usize,
+    mesh: usize,
+    transform: Mat4,
+}
+
+/// The meshes the scene's nodes place, with each node's world transform. The hierarchy must
+/// be a set of trees, as glTF requires: a node has at most one parent and is never its own
+/// ancestor, so each is visited once (a cycle would otherwise never end, and a node reached
+/// by many paths could multiply its mesh without bound).
+fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
+    let nodes = &root.nodes;
+    let n = nodes.len();
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for (i, node) in nodes.iter().enumerate() {
+        for (k, child) in node.children.iter().flatten().enumerate() {
+            let c = exists(child.value(), n, "node")
+                .map_err(|e| format!("nodes[{i}].children[{k}]: {e}"))?;
+            if c == i {
+                return Err(format!("nodes[{i}] is its own child"));
+            }
+            if let Some(p) = parent[c] {
+                return Err(format!(
+                    "nodes[{c}] is a child of both nodes[{p}] and nodes[{i}]; a glTF node has at \
+                     most one parent"
+                ));
+            }
+            parent[c] = Some(i);
+        }
+        if let Some(m) = node.mesh {
+            exists(m.value(), root.meshes.len(), "mesh")
+                .map_err(|e| format!("nodes[{i}].mesh: {e}"))?;
+        }
+    }
+    // With one parent at most, following parents from any node either ends at a root or
+    // comes back to a node on the way: a cycle.
+    const NEW: u8 = 0;
+    const ON_CHAIN: u8 = 1;
+    const DONE: u8 = 2;
+    let mut state = vec![NEW; n];
+    for start in 0..n {
+        let mut chain = Vec::new();
+        let mut at = Some(start);
+        while let Some(i) = at {
+            match state[i] {
+                DONE => break,
+                ON_CHAIN => {
+                    // Parent to child: i, then the chain back down to i.
+                    let from = chain.iter().position(|&c| c == i).unwrap_or(0);
+                    let cycle: Vec<usize> = std::iter::once(i)
+                        .chain(chain[from..].iter().rev().copied())
+                        .collect();
+                    let shown: Vec<String> = cycle
+                        .iter()
+                        .take(8)
+                        .map(|c| format!("nodes[{c}]"))
+                        .collect();
+                    return Err(format!(
+                        "nodes[{i}] is its own ancestor: the node hierarchy has a cycle ({}{})",
+                        shown.join(" → "),
+                        if cycle.len() > 8 { " → …" } else { "" }
+                    ));
+                }
+                _ => {}
+            }
+            state[i] = ON_CHAIN;
+            chain.push(i);
+            at = parent[i];
+        }
+        for i in chain {
+            state[i] = DONE;
+        }
+    }
+
+    let s = root.scene.map_or(0, |s| s.value());
+    if root.scenes.is_empty() {
+        return Err("malformed glTF: no scene".to_string());
+    }
+    let scene =
+        &root.scenes[exists(s, root.scenes.len(), "scene").map_err(|e| format!("scene: {e}"))?];
+    let mut listed = vec![false; n];
+    let mut stack = Vec::new();
+    for (k, r) in scene.nodes.iter().enumerate() {
+        let field = format!("scenes[{s}].nodes[{k}]");
+        let r = exists(r.value(), n, "node").map_err(|e| format!("{field}: {e}"))?;
+        if let Some(p) = parent[r] {
+            return Err(format!(
+                "{field}: nodes[{r}] is a child of nodes[{p}]; a scene lists only root nodes"
+            ));
+        }
+        if std::mem::replace(&mut listed[r], true) {
+            return Err(format!("{field}: nodes[{r}] is listed twice"));
+        }
+        stack.push((r, Mat4::IDENTITY));
+    }
+    let mut instances = Vec::new();
+    while let Some((i, parent_transform)) = stack.pop() {
+        let node = &nodes[i];
+        let local = match node.matrix {
+            Some(m) => Mat4::from_cols_array(&m),
+            None => Mat4::from_scale_rotation_translation(
+                Vec3::from(node.scale.unwrap_or([1.0; 3])),
+                Quat::from_array(node.rotation.map_or([0.0, 0.0, 0.0, 1.0], |q| q.0)),
+                Vec3::from(node.translation.unwrap_or([0.0; 3])),
+            ),
+        };
+        let transform = parent_transform * local;
+        if !transform.is_finite() {
+            return Err(format!(
+                "nodes[{i}]: its transform (with its ancestors') is not finite"
+            ));
+        }
+        for child in node.children.iter().flatten() {
+            stack.push((child.value(), transform));
+        }
+        if let Some(mesh) = node.mesh {
+            instances.push(Instance {
+                node: i,
+                mesh: mesh.value(),
+                transform,
+            });
+        }
+    }
+    Ok(instances)
+}
+
+/// A glTF material as glint's, its colour texture's file, and whether it has other textures:
+/// `pbrMetallicRoughness`: baseColorFactor; metallicFactor ≥ 0.5 → metal with
 /// roughnessFactor, else diffuse; KHR_materials_transmission > 0.5 → dielectric with
 /// KHR_materials_ior (default 1.5); emissiveFactor × KHR_materials_emissive_strength → emission.
-fn gltf_material(m: &gltf::Material, index: usize) -> Result<(Material, bool), String> {
-    // By index: the `names` feature of gltf would keep every name in memory for this alone.
+fn material(
+    root: &json::Root,
+    m: &json::Material,
+    index: usize,
+    dir: &Path,
+) -> Result<(Material, Option<PathBuf>, bool), String> {
     let name = format!("material{index}");
-    let pbr = m.pbr_metallic_roughness();
-    let base = Vec3::from_slice(&pbr.base_color_factor()[..3]);
-    let kind = if m
-        .transmission()
-        .is_some_and(|t| t.transmission_factor() > 0.5)
-    {
+    let extensions = m.extensions.as_ref();
+    let pbr = &m.pbr_metallic_roughness;
+    let transmission = extensions
+        .and_then(|e| e.transmission.as_ref())
+        .map(|t| t.transmission_factor.0);
+    let kind = if transmission.is_some_and(|t| t > 0.5) {
+        let ior = extensions
+            .and_then(|e| e.ior.as_ref())
+            .map(|i| i.ior.0)
+            .filter(|&n| n > 0.0)
+            .unwrap_or(1.5);
         MaterialKind::Dielectric {
-            ior: m.ior().filter(|&n| n > 0.0).unwrap_or(1.5),
+            ior: check_ior(&name, "KHR_materials_ior", ior)?,
         }
-    } else if pbr.metallic_factor() >= 0.5 {
+    } else if pbr.metallic_factor.0 >= 0.5 {
         MaterialKind::Metal {
-            roughness: pbr.roughness_factor().clamp(0.0, 1.0),
+            roughness: pbr.roughness_factor.0.clamp(0.0, 1.0),
         }
     } else {
         MaterialKind::Diffuse
     };
-    let color = check_reflectance(&name, "baseColorFactor", base)?;
+    let color = check_reflectance(
+        &name,
+        "baseColorFactor",
+        Vec3::from_slice(&pbr.base_color_factor.0[..3]),
+    )?;
+    let strength = match extensions.and_then(|e| e.emissive_strength.as_ref()) {
+        Some(s) => {
+            let s = s.emissive_strength.0;
+            check_emission(&name, "KHR_materials_emissive_strength", Vec3::splat(s))?;
+            s
+        }
+        None => 1.0,
+    };
     let emission = check_emission(
         &name,
         "emissiveFactor × emissive strength",
-        Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0),
+        Vec3::from(m.emissive_factor.0) * strength,
     )?;
-    let textures = pbr.metallic_roughness_texture().is_some()
-        || m.normal_texture().is_some()
-        || m.occlusion_texture().is_some()
-        || m.emissive_texture().is_some();
+    // The base colour: an image by URI (relative to the glTF file) on texture coordinate set
+    // 0. Embedded images (buffer views, data URIs) and other sets are not read.
+    let mut color_texture = None;
+    let mut other_textures = pbr.metallic_roughness_texture.is_some()
+        || m.normal_texture.is_some()
+        || m.occlusion_texture.is_some()
+        || m.emissive_texture.is_some();
+    if let Some(info) = &pbr.base_color_texture {
+        let t = exists(info.index.value(), root.textures.len(), "texture").map_err(|e| {
+            format!("materials[{index}].pbrMetallicRoughness.baseColorTexture.index: {e}")
+        })?;
+        let image = &root.images[root.textures[t].source.value()];
+        color_texture = image
+            .uri
+            .as_deref()
+            .filter(|uri| info.tex_coord == 0 && !uri.starts_with("data:"))
+            .and_then(|uri| resolve_uri(uri, dir).ok());
+        // Not read (embedded, on another set, an http: URI): ignored with the others.
+        other_textures |= color_texture.is_none();
+    }
     Ok((
         Material {
             name,
@@ -48,94 +533,470 @@ fn gltf_material(m: &gltf::Material, index: usize) -> Result<(Material, bool), S
             color_texture: None,
             roughness_texture: None,
         },
-        textures,
+        color_texture,
+        other_textures,
     ))
 }
 
-pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
-    let bytes = read_mesh_bytes(path)?;
-    let gltf = gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| format!("malformed glTF: {}", one_line(&e.to_string())))?;
-    let buffers = gltf::import_buffers(&gltf.document, path.parent(), gltf.blob.clone())
-        .map_err(|e| format!("glTF buffers: {e}"))?;
-    let mut materials = Vec::new();
-    let mut color_textures = Vec::new();
-    let mut has_other_textures = false;
-    for (i, m) in gltf.document.materials().enumerate() {
-        let base = m.pbr_metallic_roughness().base_color_texture();
-        // Images referred to by URI, relative to the glTF file, on texture coordinate set 0;
-        // embedded images (buffer views, data URIs) and other sets are not read.
-        let file = base
-            .as_ref()
-            .and_then(|info| match info.texture().source().source() {
-                gltf::image::Source::Uri { uri, .. }
-                    if info.tex_coord() == 0 && !uri.starts_with("data:") =>
-                {
-                    Some(path.parent().unwrap_or(Path::new("")).join(uri))
-                }
-                _ => None,
-            });
-        has_other_textures |= base.is_some() && file.is_none();
-        color_textures.push(file);
-        let (m, textures) = gltf_material(&m, i)?;
-        has_other_textures |= textures;
-        materials.push(m);
-    }
-    let mut parts = Vec::new();
-    let scene = gltf
-        .document
-        .default_scene()
-        .or_else(|| gltf.document.scenes().next())
-        .ok_or("malformed glTF: no scene")?;
-    let mut stack: Vec<(gltf::Node, Mat4)> = scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
-    while let Some((node, parent)) = stack.pop() {
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-        for child in node.children() {
-            stack.push((child, world));
-        }
-        let Some(mesh) = node.mesh() else { continue };
-        let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
-        for (p, primitive) in mesh.primitives().enumerate() {
-            let name = format!("mesh {} primitive {p}", mesh.index());
-            if primitive.mode() != gltf::mesh::Mode::Triangles {
+/// A primitive, checked, with the accessors to read.
+struct PrimitivePlan {
+    positions: usize,
+    normals: Option<usize>,
+    uvs: Option<usize>,
+    indices: Option<usize>,
+    material: Option<usize>,
+    triangles: u64,
+}
+
+/// Checks mesh `m`'s primitives and their accessors against the buffers, reading nothing.
+fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<PrimitivePlan>, String> {
+    let mut plans = Vec::new();
+    for (p, primitive) in root.meshes[m].primitives.iter().enumerate() {
+        let name = format!("meshes[{m}].primitives[{p}]");
+        match primitive.mode {
+            Checked::Valid(Mode::Triangles) => {}
+            Checked::Valid(other) => {
                 return Err(format!(
-                    "{name}: mode {:?} is not supported; only triangle lists are",
-                    primitive.mode()
-                ));
+                    "{name}: mode {other:?} is not supported; only triangle lists are"
+                ))
             }
-            let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| format!("{name}: no POSITION attribute"))?
-                .map(|p| world.transform_point3(Vec3::from(p)))
-                .collect();
-            let normals: Vec<Vec3> = reader
-                .read_normals()
-                .map(|n| n.map(|n| normal_matrix * Vec3::from(n)).collect())
-                .unwrap_or_default();
-            // glTF's texture coordinates have v down (the image's top row at v = 0).
-            let uvs: Vec<Vec2> = reader
-                .read_tex_coords(0)
-                .map(|t| t.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect())
-                .unwrap_or_default();
-            let flat: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..positions.len() as u32).collect(),
-            };
-            parts.push(MeshPart {
-                positions,
-                normals,
-                uvs,
-                indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-                material: primitive.material().index(),
-                name,
-            });
+            Checked::Invalid => return Err(format!("{name}.mode: not a glTF primitive mode")),
+        }
+        let attribute = |semantic: Semantic, label: &str, kind: Type| {
+            primitive
+                .attributes
+                .get(&Checked::Valid(semantic))
+                .map(|a| {
+                    let field = format!("{name}.attributes.{label}");
+                    let a = exists(a.value(), root.accessors.len(), "accessor")
+                        .map_err(|e| format!("{field}: {e}"))?;
+                    let layout = Layout::of(root, buffers, a, kind, false)?;
+                    Ok::<_, String>((a, layout.count))
+                })
+                .transpose()
+        };
+        let (positions, vertices) = attribute(Semantic::Positions, "POSITION", Type::Vec3)?
+            .ok_or_else(|| format!("{name}.attributes: no POSITION"))?;
+        let normals = attribute(Semantic::Normals, "NORMAL", Type::Vec3)?;
+        let uvs = attribute(Semantic::TexCoords(0), "TEXCOORD_0", Type::Vec2)?;
+        for (label, other) in [("NORMAL", normals), ("TEXCOORD_0", uvs)] {
+            if let Some((a, count)) = other {
+                if count != vertices {
+                    return Err(format!(
+                        "{name}.attributes.{label}: accessors[{a}] has {count} elements, but \
+                         POSITION (accessors[{positions}]) has {vertices}"
+                    ));
+                }
+            }
+        }
+        let indices = match primitive.indices {
+            Some(i) => {
+                let i = exists(i.value(), root.accessors.len(), "accessor")
+                    .map_err(|e| format!("{name}.indices: {e}"))?;
+                Some((i, Layout::of(root, buffers, i, Type::Scalar, true)?.count))
+            }
+            None => None,
+        };
+        let material = match primitive.material {
+            Some(i) => Some(
+                exists(i.value(), root.materials.len(), "material")
+                    .map_err(|e| format!("{name}.material: {e}"))?,
+            ),
+            None => None,
+        };
+        plans.push(PrimitivePlan {
+            positions,
+            normals: normals.map(|(a, _)| a),
+            uvs: uvs.map(|(a, _)| a),
+            indices: indices.map(|(a, _)| a),
+            material,
+            triangles: indices.map_or(vertices, |(_, count)| count) as u64 / 3,
+        });
+    }
+    Ok(plans)
+}
+
+/// Where an accessor's elements lie, checked against its buffer views.
+struct Layout<'a> {
+    index: usize,
+    count: usize,
+    component: ComponentType,
+    components: usize,
+    normalized: bool,
+    /// The bytes from the first element on, and the distance between elements; `None`: zeros.
+    data: Option<(&'a [u8], usize)>,
+    sparse: Option<Sparse<'a>>,
+}
+
+struct Sparse<'a> {
+    count: usize,
+    index_type: ComponentType,
+    indices: &'a [u8],
+    values: &'a [u8],
+}
+
+fn component_size(c: ComponentType) -> usize {
+    match c {
+        ComponentType::I8 | ComponentType::U8 => 1,
+        ComponentType::I16 | ComponentType::U16 => 2,
+        ComponentType::U32 | ComponentType::F32 => 4,
+    }
+}
+
+fn component_name(c: ComponentType) -> &'static str {
+    match c {
+        ComponentType::I8 => "BYTE",
+        ComponentType::U8 => "UNSIGNED_BYTE",
+        ComponentType::I16 => "SHORT",
+        ComponentType::U16 => "UNSIGNED_SHORT",
+        ComponentType::U32 => "UNSIGNED_INT",
+        ComponentType::F32 => "FLOAT",
+    }
+}
+
+fn type_name(t: Type) -> &'static str {
+    match t {
+        Type::Scalar => "SCALAR",
+        Type::Vec2 => "VEC2",
+        Type::Vec3 => "VEC3",
+        Type::Vec4 => "VEC4",
+        Type::Mat2 => "MAT2",
+        Type::Mat3 => "MAT3",
+        Type::Mat4 => "MAT4",
+    }
+}
+
+/// The bytes of buffer view `v` from `offset`, which must hold `needed` bytes.
+fn view_bytes<'a>(
+    root: &json::Root,
+    buffers: &'a Buffers,
+    v: usize,
+    offset: u64,
+    needed: u64,
+    what: &dyn Fn() -> String,
+) -> Result<&'a [u8], String> {
+    let view = &root.buffer_views[v];
+    let length = view.byte_length.0;
+    if offset.checked_add(needed).is_none_or(|end| end > length) {
+        return Err(format!(
+            "{}: needs {needed} bytes from byteOffset {offset}, but bufferViews[{v}] holds {length}",
+            what()
+        ));
+    }
+    // Inside the buffer: check_buffer_views saw the view fit.
+    let start = view.byte_offset.map_or(0, |o| o.0) + offset;
+    Ok(&buffers.data[view.buffer.value()][start as usize..(start + needed) as usize])
+}
+
+impl<'a> Layout<'a> {
+    /// Accessor `a`, of type `kind`: indices (`is_index`: unsigned integers) or a vertex
+    /// attribute (any component type but UNSIGNED_INT; integers are KHR_mesh_quantization's).
+    fn of(
+        root: &json::Root,
+        buffers: &'a Buffers,
+        a: usize,
+        kind: Type,
+        is_index: bool,
+    ) -> Result<Layout<'a>, String> {
+        let accessor = &root.accessors[a];
+        let field = format!("accessors[{a}]");
+        let Checked::Valid(t) = accessor.type_ else {
+            return Err(format!("{field}.type: not a glTF accessor type"));
+        };
+        let Checked::Valid(json::accessor::GenericComponentType(component)) =
+            accessor.component_type
+        else {
+            return Err(format!("{field}.componentType: not a glTF component type"));
+        };
+        if t != kind {
+            return Err(format!(
+                "{field}: type {}, but this use needs {}",
+                type_name(t),
+                type_name(kind)
+            ));
+        }
+        let allowed = if is_index {
+            matches!(
+                component,
+                ComponentType::U8 | ComponentType::U16 | ComponentType::U32
+            )
+        } else {
+            component != ComponentType::U32
+        };
+        if !allowed {
+            return Err(format!(
+                "{field}: componentType {} is not allowed for {}",
+                component_name(component),
+                if is_index {
+                    "indices"
+                } else {
+                    "this attribute"
+                }
+            ));
+        }
+        let components = match kind {
+            Type::Scalar => 1,
+            Type::Vec2 => 2,
+            Type::Vec3 => 3,
+            _ => 4,
+        };
+        let element = (components * component_size(component)) as u64;
+        let count = accessor.count.0;
+        let data = match accessor.buffer_view {
+            Some(v) => {
+                let v = v.value();
+                let stride = root.buffer_views[v]
+                    .byte_stride
+                    .map_or(element, |s| s.0 as u64);
+                if stride < element {
+                    return Err(format!(
+                        "{field}: bufferViews[{v}]'s byteStride {stride} is less than one element \
+                         ({} of {}, {element} bytes)",
+                        type_name(kind),
+                        component_name(component)
+                    ));
+                }
+                let offset = accessor.byte_offset.map_or(0, |o| o.0);
+                // The last element ends `element` bytes after its start.
+                let needed = match count {
+                    0 => 0,
+                    c => (c - 1)
+                        .checked_mul(stride)
+                        .and_then(|n| n.checked_add(element))
+                        .unwrap_or(u64::MAX),
+                };
+                let what = || format!("{field}: {count} elements with stride {stride}");
+                Some((
+                    view_bytes(root, buffers, v, offset, needed, &what)?,
+                    stride as usize,
+                ))
+            }
+            None => {
+                // Zeros, but for the sparse values: nothing bounds the count but the file's
+                // size, so the elements must not outnumber what its buffers could hold.
+                if count.saturating_mul(element) > buffers.total {
+                    return Err(format!(
+                        "{field}: {count} elements of {element} bytes without a bufferView, more \
+                         than the file's {} bytes of buffers could hold",
+                        buffers.total
+                    ));
+                }
+                None
+            }
+        };
+        let sparse = match &accessor.sparse {
+            None => None,
+            Some(s) => {
+                let sparse_count = s.count.0;
+                if sparse_count > count {
+                    return Err(format!(
+                        "{field}.sparse.count: {sparse_count}, more than the accessor's {count} \
+                         elements"
+                    ));
+                }
+                let Checked::Valid(json::accessor::IndexComponentType(index_type)) =
+                    s.indices.component_type
+                else {
+                    return Err(format!(
+                        "{field}.sparse.indices.componentType: not a glTF component type"
+                    ));
+                };
+                if !matches!(
+                    index_type,
+                    ComponentType::U8 | ComponentType::U16 | ComponentType::U32
+                ) {
+                    return Err(format!(
+                        "{field}.sparse.indices.componentType: {} is not an index type",
+                        component_name(index_type)
+                    ));
+                }
+                let index_bytes = sparse_count.saturating_mul(component_size(index_type) as u64);
+                let what = || format!("{field}.sparse.indices: {sparse_count} indices");
+                let indices = view_bytes(
+                    root,
+                    buffers,
+                    s.indices.buffer_view.value(),
+                    s.indices.byte_offset.0,
+                    index_bytes,
+                    &what,
+                )?;
+                let what = || format!("{field}.sparse.values: {sparse_count} values");
+                let values = view_bytes(
+                    root,
+                    buffers,
+                    s.values.buffer_view.value(),
+                    s.values.byte_offset.0,
+                    sparse_count.saturating_mul(element),
+                    &what,
+                )?;
+                Some(Sparse {
+                    count: sparse_count as usize,
+                    index_type,
+                    indices,
+                    values,
+                })
+            }
+        };
+        Ok(Layout {
+            index: a,
+            count: count as usize,
+            component,
+            components,
+            normalized: accessor.normalized,
+            data,
+            sparse,
+        })
+    }
+
+    fn element_size(&self) -> usize {
+        self.components * component_size(self.component)
+    }
+
+    /// Element `i`'s bytes in the dense data (`None`: zeros).
+    fn element(&self, i: usize) -> Option<&'a [u8]> {
+        self.data.map(|(bytes, stride)| &bytes[i * stride..])
+    }
+
+    /// Each sparse entry: the element it replaces and the new value's bytes.
+    fn sparse_entries(&self) -> Result<Vec<(usize, &'a [u8])>, String> {
+        let Some(s) = &self.sparse else {
+            return Ok(Vec::new());
+        };
+        let size = component_size(s.index_type);
+        (0..s.count)
+            .map(|k| {
+                let target = unsigned(&s.indices[k * size..], s.index_type) as usize;
+                if target >= self.count {
+                    return Err(format!(
+                        "accessors[{}].sparse.indices[{k}]: {target}, but the accessor has only {} \
+                         elements",
+                        self.index, self.count
+                    ));
+                }
+                Ok((target, &s.values[k * self.element_size()..]))
+            })
+            .collect()
+    }
+
+    /// Every element's components as f32, normalized integers mapped to [0, 1] or [-1, 1].
+    fn floats<const N: usize>(&self) -> Result<Vec<[f32; N]>, String> {
+        debug_assert_eq!(N, self.components);
+        let component = |bytes: &[u8], c: usize| -> f32 {
+            let size = component_size(self.component);
+            float(&bytes[c * size..], self.component, self.normalized)
+        };
+        let mut out: Vec<[f32; N]> = (0..self.count)
+            .map(|i| match self.element(i) {
+                Some(e) => std::array::from_fn(|c| component(e, c)),
+                None => [0.0; N],
+            })
+            .collect();
+        for (target, bytes) in self.sparse_entries()? {
+            out[target] = std::array::from_fn(|c| component(bytes, c));
+        }
+        Ok(out)
+    }
+
+    fn indices(&self) -> Result<Vec<u32>, String> {
+        let mut out: Vec<u32> = (0..self.count)
+            .map(|i| self.element(i).map_or(0, |e| unsigned(e, self.component)))
+            .collect();
+        for (target, bytes) in self.sparse_entries()? {
+            out[target] = unsigned(bytes, self.component);
+        }
+        Ok(out)
+    }
+}
+
+fn unsigned(bytes: &[u8], c: ComponentType) -> u32 {
+    match c {
+        ComponentType::U8 | ComponentType::I8 => bytes[0] as u32,
+        ComponentType::U16 | ComponentType::I16 => u16::from_le_bytes([bytes[0], bytes[1]]) as u32,
+        ComponentType::U32 | ComponentType::F32 => {
+            u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])
         }
     }
-    Ok(MeshFile {
-        parts,
-        materials,
-        color_textures,
-        has_other_textures,
-    })
+}
+
+/// One component as glTF defines it: floats as they are, normalized integers mapped to
+/// [0, 1] (unsigned) or [-1, 1] (signed), other integers as their value.
+fn float(bytes: &[u8], c: ComponentType, normalized: bool) -> f32 {
+    let (value, max) = match c {
+        ComponentType::F32 => {
+            return f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+        }
+        ComponentType::I8 => (bytes[0] as i8 as f32, 127.0),
+        ComponentType::U8 => (bytes[0] as f32, 255.0),
+        ComponentType::I16 => (i16::from_le_bytes([bytes[0], bytes[1]]) as f32, 32767.0),
+        ComponentType::U16 => (u16::from_le_bytes([bytes[0], bytes[1]]) as f32, 65535.0),
+        ComponentType::U32 => (unsigned(bytes, c) as f32, u32::MAX as f32),
+    };
+    if normalized {
+        (value / max).max(-1.0)
+    } else {
+        value
+    }
+}
+
+/// Reads primitives' accessors, keeping the decoded bytes within a budget set by the size of
+/// the file's buffers.
+struct Decoder<'a> {
+    root: &'a json::Root,
+    buffers: &'a Buffers,
+    budget: u64,
+}
+
+impl Decoder<'_> {
+    fn layout(&mut self, a: usize, kind: Type, is_index: bool) -> Result<Layout<'_>, String> {
+        let layout = Layout::of(self.root, self.buffers, a, kind, is_index)?;
+        let bytes = layout.count as u64 * layout.components as u64 * 4;
+        if bytes > self.budget {
+            return Err(format!(
+                "accessors[{a}]: decoding it would bring the file's vertex data to more than \
+                 {DECODE_RATIO} bytes per byte of its {} bytes of buffers (do its accessors \
+                 overlap?)",
+                self.buffers.total
+            ));
+        }
+        self.budget -= bytes;
+        Ok(layout)
+    }
+
+    fn geometry(&mut self, plan: &PrimitivePlan) -> Result<Geometry, String> {
+        let positions = self
+            .layout(plan.positions, Type::Vec3, false)?
+            .floats::<3>()?
+            .into_iter()
+            .map(Vec3::from)
+            .collect::<Vec<_>>();
+        let normals = match plan.normals {
+            Some(a) => self
+                .layout(a, Type::Vec3, false)?
+                .floats::<3>()?
+                .into_iter()
+                .map(Vec3::from)
+                .collect(),
+            None => Vec::new(),
+        };
+        // glTF's texture coordinates have v down (the image's top row at v = 0).
+        let uvs = match plan.uvs {
+            Some(a) => self
+                .layout(a, Type::Vec2, false)?
+                .floats::<2>()?
+                .into_iter()
+                .map(|[u, v]| Vec2::new(u, 1.0 - v))
+                .collect(),
+            None => Vec::new(),
+        };
+        let flat: Vec<u32> = match plan.indices {
+            Some(a) => self.layout(a, Type::Scalar, true)?.indices()?,
+            None => (0..positions.len() as u32).collect(),
+        };
+        Ok(Geometry {
+            positions,
+            normals,
+            uvs,
+            indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        })
+    }
 }

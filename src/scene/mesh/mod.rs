@@ -10,11 +10,13 @@ mod gltf;
 mod obj;
 mod ply;
 
+use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{TextureSet, TextureUse};
 use super::{Material, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
 /// fit any GPU's storage binding anyway.
@@ -39,18 +41,38 @@ impl MeshTransform {
     }
 }
 
-/// A part of a mesh file with one material: positions, optional vertex normals (as many as
-/// positions), and triangles as indices into them.
-pub(super) struct MeshPart {
+/// Triangles with one material, in the file's own coordinates: positions, optional vertex
+/// normals (as many as positions), and triangles as indices into them.
+pub(super) struct Geometry {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     /// Texture coordinates (v up), as many as positions, or none.
     uvs: Vec<Vec2>,
     indices: Vec<[u32; 3]>,
+}
+
+/// A part of a mesh file: its geometry, placed in the file's space. A glTF mesh used by several
+/// nodes is one geometry shared by several parts, read once.
+pub(super) struct MeshPart {
+    geometry: Rc<Geometry>,
+    /// The file's own placement (a glTF node's world transform), before the scene's.
+    transform: Mat4,
     /// Index into the file's materials, if the file gives one.
     material: Option<usize>,
-    /// Where the part came from, for messages (an OBJ object, a glTF mesh).
+    /// Where the part came from, for messages (an OBJ object, a glTF node and mesh).
     name: String,
+}
+
+impl MeshPart {
+    /// A part the file places as it is (OBJ, PLY).
+    fn unplaced(geometry: Geometry, material: Option<usize>, name: String) -> Self {
+        MeshPart {
+            geometry: Rc::new(geometry),
+            transform: Mat4::IDENTITY,
+            material,
+            name,
+        }
+    }
 }
 
 /// What a mesh file holds.
@@ -61,6 +83,8 @@ pub(super) struct MeshFile {
     color_textures: Vec<Option<PathBuf>>,
     /// Whether any material refers to a texture glint does not use (normal maps, ...).
     has_other_textures: bool,
+    /// Anything else worth a warning line, each a sentence without the file's name.
+    warnings: Vec<String>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -104,7 +128,11 @@ pub(super) fn load(
         _ => self::gltf::read_gltf(path),
     }
     .map_err(|e| format!("{shown}: {e}"))?;
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = file
+        .warnings
+        .iter()
+        .map(|w| format!("{shown}: {w}"))
+        .collect();
     if file.has_other_textures {
         warnings.push(format!(
             "{shown}: texture maps other than the base colour (normal, roughness, emission, ...) are ignored"
@@ -116,13 +144,18 @@ pub(super) fn load(
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let matrix = transform.matrix();
-    // Normals go through the inverse transpose of the linear part.
-    let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
+    let scene_matrix = transform.matrix();
     let mut triangles = Vec::new();
     let mut degenerate = 0usize;
+    let mut checked = std::collections::HashSet::new();
     for part in &file.parts {
-        for (i, p) in part.positions.iter().enumerate() {
+        let matrix = scene_matrix * part.transform;
+        // Normals go through the inverse transpose of the linear part.
+        let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
+        let geometry = &*part.geometry;
+        // A geometry placed by many glTF nodes is checked once.
+        let first_use = checked.insert(Rc::as_ptr(&part.geometry));
+        for (i, p) in geometry.positions.iter().enumerate().filter(|_| first_use) {
             if !p.is_finite() {
                 return Err(format!(
                     "{shown}: {}vertex {i} is not finite: {p}",
@@ -130,13 +163,13 @@ pub(super) fn load(
                 ));
             }
         }
-        let use_normals = smooth && !part.normals.is_empty();
-        if use_normals {
-            if let Some(i) = part.normals.iter().position(|n| !n.is_finite()) {
+        let use_normals = smooth && !geometry.normals.is_empty();
+        if use_normals && first_use {
+            if let Some(i) = geometry.normals.iter().position(|n| !n.is_finite()) {
                 return Err(format!(
                     "{shown}: {}vertex normal {i} is not finite: {}",
                     part_prefix(&part.name),
-                    part.normals[i]
+                    geometry.normals[i]
                 ));
             }
         }
@@ -173,15 +206,15 @@ pub(super) fn load(
                 }
             }
         };
-        let count = part.positions.len();
-        for (f, idx) in part.indices.iter().enumerate() {
+        let count = geometry.positions.len();
+        for (f, idx) in geometry.indices.iter().enumerate() {
             if let Some(&bad) = idx.iter().find(|&&i| i as usize >= count) {
                 return Err(format!(
                     "{shown}: {}face {f} refers to vertex {bad}, but there are only {count} vertices",
                     part_prefix(&part.name)
                 ));
             }
-            let v = idx.map(|i| matrix.transform_point3(part.positions[i as usize]));
+            let v = idx.map(|i| matrix.transform_point3(geometry.positions[i as usize]));
             let cross = (v[1] - v[0]).cross(v[2] - v[0]);
             let area2 = cross.length();
             if area2.is_nan() || area2 <= 0.0 || !area2.is_finite() {
@@ -196,11 +229,11 @@ pub(super) fn load(
             }
             let normals = use_normals
                 .then(|| {
-                    idx.map(|i| (normal_matrix * part.normals[i as usize]).normalize_or_zero())
+                    idx.map(|i| (normal_matrix * geometry.normals[i as usize]).normalize_or_zero())
                 })
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
-            let uvs = (part.uvs.len() == count).then(|| idx.map(|i| part.uvs[i as usize]));
+            let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
             triangles.push(Triangle {
                 vertices: v,
                 normals,
@@ -258,11 +291,30 @@ fn check_reflectance(name: &str, what: &str, c: Vec3) -> Result<Vec3, String> {
     Ok(c)
 }
 
+/// An emitted radiance: ≥ 0 and within glint's numeric range, as in scene files.
 fn check_emission(name: &str, what: &str, e: Vec3) -> Result<Vec3, String> {
     if !e.is_finite() || e.min_element() < 0.0 {
         return Err(format!("material {name:?}: {what} must be ≥ 0, got {e}"));
     }
+    if f64::from(e.max_element()) > MAX_RADIANCE {
+        return Err(format!(
+            "material {name:?}: {what} of {:e} is too bright: at most {MAX_RADIANCE:e} per \
+             channel (the numeric range glint supports)",
+            e.max_element()
+        ));
+    }
     Ok(e)
+}
+
+/// A dielectric's index of refraction within glint's numeric range, as in scene files.
+fn check_ior(name: &str, what: &str, ior: f32) -> Result<f32, String> {
+    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+        return Err(format!(
+            "material {name:?}: {what} must be in [{MIN_IOR}, {MAX_IOR}] (the numeric range \
+             glint supports), got {ior}"
+        ));
+    }
+    Ok(ior)
 }
 
 /// The bytes of a mesh file, if it is a regular file within [`MESH_FILE_LIMIT`].

@@ -1,6 +1,8 @@
 //! OBJ files and their `.mtl` materials, read by `tobj`.
 
-use super::{check_emission, check_reflectance, read_mesh_bytes, MeshFile, MeshPart};
+use super::{
+    check_emission, check_ior, check_reflectance, read_mesh_bytes, Geometry, MeshFile, MeshPart,
+};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Material, MaterialKind};
 use glam::{Vec2, Vec3};
@@ -36,6 +38,7 @@ impl<R: BufRead> BufRead for LineCounter<R> {
         self.inner.consume(amount);
     }
 }
+
 /// OBJ `.mtl`: Kd → diffuse colour, Ke → emission, d < 1 → dielectric with Ni (default 1.5),
 /// illum 3 or 5 → mirror with Ks (else Kd).
 fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
@@ -45,7 +48,9 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
     let emission = check_emission(name, "Ke", Vec3::from(m.emissive.unwrap_or([0.0; 3])))?;
     let kind = if m.dissolve.is_some_and(|d| d < 1.0) {
         let ior = m.optical_density.filter(|&n| n > 0.0).unwrap_or(1.5);
-        MaterialKind::Dielectric { ior }
+        MaterialKind::Dielectric {
+            ior: check_ior(name, "Ni", ior)?,
+        }
     } else if matches!(m.illumination_model, Some(3) | Some(5)) {
         MaterialKind::Specular
     } else {
@@ -82,6 +87,7 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
         textures,
     ))
 }
+
 pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
     let bytes = read_mesh_bytes(path)?;
     let mut reader = LineCounter {
@@ -121,22 +127,24 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
         .into_iter()
         .map(|model| {
             let mesh = model.mesh;
-            MeshPart {
-                positions: triples(&mesh.positions),
-                normals: triples(&mesh.normals),
-                uvs: mesh
-                    .texcoords
-                    .chunks_exact(2)
-                    .map(Vec2::from_slice)
-                    .collect(),
-                indices: mesh
-                    .indices
-                    .chunks_exact(3)
-                    .map(|c| [c[0], c[1], c[2]])
-                    .collect(),
-                material: mesh.material_id.filter(|&i| i < converted.len()),
-                name: format!("object {:?}", model.name),
-            }
+            MeshPart::unplaced(
+                Geometry {
+                    positions: triples(&mesh.positions),
+                    normals: triples(&mesh.normals),
+                    uvs: mesh
+                        .texcoords
+                        .chunks_exact(2)
+                        .map(Vec2::from_slice)
+                        .collect(),
+                    indices: mesh
+                        .indices
+                        .chunks_exact(3)
+                        .map(|c| [c[0], c[1], c[2]])
+                        .collect(),
+                },
+                mesh.material_id.filter(|&i| i < converted.len()),
+                format!("object {:?}", model.name),
+            )
         })
         .collect();
     Ok(MeshFile {
@@ -144,6 +152,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
         materials: converted,
         color_textures,
         has_other_textures,
+        warnings: Vec::new(),
     })
 }
 

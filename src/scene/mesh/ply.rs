@@ -1,7 +1,7 @@
 //! PLY files (ASCII and binary), read by `ply-rs-bw`: vertices, optional normals, and faces
 //! (polygons split into fans). PLY carries no materials.
 
-use super::{one_line, read_mesh_bytes, MeshFile, MeshPart};
+use super::{one_line, read_mesh_bytes, Geometry, MeshFile, MeshPart};
 use glam::Vec3;
 use std::path::Path;
 
@@ -87,16 +87,19 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
         }
     }
     Ok(MeshFile {
-        parts: vec![MeshPart {
-            positions,
-            normals,
-            uvs: Vec::new(),
-            indices,
-            material: None,
-            name: String::new(),
-        }],
+        parts: vec![MeshPart::unplaced(
+            Geometry {
+                positions,
+                normals,
+                uvs: Vec::new(),
+                indices,
+            },
+            None,
+            String::new(),
+        )],
         materials: Vec::new(),
         color_textures: Vec::new(),
         has_other_textures: false,
+        warnings: Vec::new(),
     })
 }

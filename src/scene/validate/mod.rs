@@ -4,6 +4,7 @@
 
 mod environment;
 mod fields;
+mod lights;
 mod materials;
 mod objects;
 
@@ -145,14 +146,24 @@ impl SceneToml {
             folder,
             &mut materials,
         )?;
+        let mut warnings = objects.warnings;
         let environment = match &self.environment {
-            Some(e) => Some(environment::validate_environment(
-                e,
-                render.background.is_some(),
-                folder,
-            )?),
+            Some(e) => {
+                let environment =
+                    environment::validate_environment(e, render.background.is_some(), folder)?;
+                if let Some(clamped) = environment.image.clamped {
+                    warnings.push(format!(
+                        "{}: {}",
+                        e.get_ref().file.get_ref(),
+                        clamped.warning()
+                    ));
+                }
+                Some(environment)
+            }
             None => None,
         };
+        let mut textures = materials.textures;
+        warnings.append(&mut textures.warnings);
         let scene = Scene {
             name,
             camera: Camera {
@@ -177,9 +188,10 @@ impl SceneToml {
             spheres: objects.spheres,
             quads: objects.quads,
             triangles: objects.triangles,
-            textures: materials.textures,
+            textures,
             environment,
+            lights: lights::validate_lights(&self.lights)?,
         };
-        Ok((scene, objects.warnings))
+        Ok((scene, warnings))
     }
 }
