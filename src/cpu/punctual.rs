@@ -6,9 +6,9 @@
 //! environment map's.
 
 use super::bvh::{bvh_ray, bvh_traverse};
+use super::frame::{basis, PI};
 use super::intersect::{closest_primitive, escapes};
 use super::lights::{power_heuristic, LightSample};
-use super::frame::{basis, PI};
 use super::trace::SceneRefs;
 use super::Ray;
 use crate::shader_types::{
