@@ -1,9 +1,11 @@
-//! Python dictionaries and lists → TOML text, which glint's own parser then reads: a scene
-//! given as a dictionary is checked exactly as a file is, with the same messages.
+//! Python dictionaries and lists ↔ TOML: a scene given as a dictionary is written out as TOML
+//! text, which glint's own parser then reads, so it is checked exactly as a file is, with the
+//! same messages; a scene's TOML is read back as dictionaries for editing.
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use pyo3::IntoPyObjectExt;
 use toml::{Table, Value};
 
 /// Deeper nesting than any scene has: a self-referencing list would otherwise recurse forever.
@@ -72,4 +74,35 @@ fn to_value(obj: &Bound<'_, PyAny>, at: &str, depth: usize) -> PyResult<Value> {
         "load_dict: {at}: a {} cannot be written in TOML (use dict, list, str, int, float or bool)",
         obj.get_type().name()?
     )))
+}
+
+/// TOML text as Python values: tables as dicts, arrays as lists, date-times as strings.
+pub fn from_toml_text<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+    let table: Table = toml::from_str(text)
+        .map_err(|e| PyValueError::new_err(format!("TOML error: {}", e.message().trim_end())))?;
+    from_value(py, &Value::Table(table))
+}
+
+fn from_value<'py>(py: Python<'py>, value: &Value) -> PyResult<Bound<'py, PyAny>> {
+    match value {
+        Value::String(s) => s.into_bound_py_any(py),
+        Value::Integer(i) => i.into_bound_py_any(py),
+        Value::Float(f) => f.into_bound_py_any(py),
+        Value::Boolean(b) => b.into_bound_py_any(py),
+        Value::Datetime(d) => d.to_string().into_bound_py_any(py),
+        Value::Array(items) => {
+            let list = PyList::empty(py);
+            for item in items {
+                list.append(from_value(py, item)?)?;
+            }
+            Ok(list.into_any())
+        }
+        Value::Table(table) => {
+            let dict = PyDict::new(py);
+            for (key, item) in table {
+                dict.set_item(key, from_value(py, item)?)?;
+            }
+            Ok(dict.into_any())
+        }
+    }
 }

@@ -3,53 +3,68 @@
 use glint::compare::{compare as compare_images, Z_TEST_ALPHA};
 use glint::output::{check_output_path, Image, ImageFormat};
 use glint::tonemap::{DisplayTransform, Tonemap};
+use numpy::ndarray::{Array3, Axis};
+use numpy::{IntoPyArray, PyArray3, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict};
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 
-/// An image's pixels as native-endian float32 bytes, row by row, RGB.
-pub fn image_bytes(image: &Image) -> Vec<u8> {
-    image
-        .pixels
-        .iter()
-        .flatten()
-        .flat_map(|v| v.to_ne_bytes())
-        .collect()
+/// An image as an H×W×3 float32 NumPy array, which takes over the pixels without a copy.
+pub fn to_numpy<'py>(py: Python<'py>, image: Image) -> Bound<'py, PyArray3<f32>> {
+    let shape = (image.height as usize, image.width as usize, 3);
+    let floats: Vec<f32> = image.pixels.into_iter().flatten().collect();
+    Array3::from_shape_vec(shape, floats)
+        .expect("an Image holds width × height pixels")
+        .into_pyarray(py)
 }
 
-/// An image from [`image_bytes`]' layout; `what` names it in the error.
-fn image_from_bytes(what: &str, data: &[u8], height: usize, width: usize) -> PyResult<Image> {
-    if data.len() != height * width * 12 {
+/// The image in `array`: anything `numpy.asarray(array, dtype=float32)` takes, of shape
+/// H×W×3, whatever its strides; `what` names it in the error.
+pub fn from_numpy(what: &str, array: &Bound<'_, PyAny>) -> PyResult<Image> {
+    let numpy = array.py().import("numpy")?;
+    let converted = numpy.call_method1("asarray", (array, "float32"))?;
+    let array: PyReadonlyArrayDyn<'_, f32> = converted.extract()?;
+    let shape = array.shape();
+    if shape.len() != 3 || shape[2] != 3 || shape[0] == 0 || shape[1] == 0 {
         return Err(PyValueError::new_err(format!(
-            "{what}: {} bytes is not a {height}×{width}×3 float32 image",
-            data.len()
+            "{what}: expected a non-empty H×W×3 array, got shape {shape:?}"
         )));
     }
-    let floats: Vec<f32> = data
-        .chunks_exact(4)
-        .map(|b| f32::from_ne_bytes(b.try_into().expect("4 bytes")))
-        .collect();
+    let (Ok(height), Ok(width)) = (u32::try_from(shape[0]), u32::try_from(shape[1])) else {
+        return Err(PyValueError::new_err(format!(
+            "{what}: shape {shape:?} is too large"
+        )));
+    };
+    let view = array.as_array();
+    let mut pixels = Vec::with_capacity(shape[0] * shape[1]);
+    for row in view.axis_iter(Axis(0)) {
+        for p in row.axis_iter(Axis(0)) {
+            pixels.push([p[0], p[1], p[2]]);
+        }
+    }
     Ok(Image {
-        width: width as u32,
-        height: height as u32,
-        pixels: floats.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect(),
+        width,
+        height,
+        pixels,
     })
 }
 
-/// The compiled half of `glint.write`: a .png through the display transform, an .exr linear.
+/// write(path, image, *, tonemap="clamp", exposure=0.0)
+///
+/// Writes an H×W×3 linear image as `glint render -o` does: .exr as float32 radiance, .png
+/// through the display transform (exposure in stops, then tonemap "clamp", "aces" or "agx",
+/// then sRGB). The write is atomic: the file is complete or absent.
 #[pyfunction]
-#[pyo3(signature = (path, data, height, width, tonemap="clamp", exposure=0.0))]
+#[pyo3(signature = (path, image, *, tonemap="clamp", exposure=0.0))]
 pub fn write(
     py: Python<'_>,
     path: PathBuf,
-    data: &[u8],
-    height: usize,
-    width: usize,
+    image: &Bound<'_, PyAny>,
     tonemap: &str,
     exposure: f64,
 ) -> PyResult<()> {
-    let image = image_from_bytes("image", data, height, width)?;
+    let image = from_numpy("image", image)?;
     let tonemap =
         Tonemap::parse(tonemap).map_err(|m| PyValueError::new_err(format!("tonemap: {m}")))?;
     if !exposure.is_finite() || exposure.abs() > 64.0 {
@@ -72,36 +87,37 @@ pub fn write(
     .map_err(|e| PyOSError::new_err(format!("{e:#}")))
 }
 
-/// The compiled half of `glint.read`: a linear .exr as bytes, height and width.
+/// read(path) -> numpy.ndarray
+///
+/// Reads a linear .exr (as `glint render -o out.exr` writes it) as an H×W×3 float32 array.
 #[pyfunction]
-pub fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<(Bound<'py, PyByteArray>, u32, u32)> {
+pub fn read<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyArray3<f32>>> {
     let image = py
         .detach(|| Image::read_exr(&path))
         .map_err(|e| PyOSError::new_err(format!("{e:#}")))?;
-    Ok((
-        PyByteArray::new(py, &image_bytes(&image)),
-        image.height,
-        image.width,
-    ))
+    Ok(to_numpy(py, image))
 }
 
-/// An image as (bytes, height, width), as the Python half passes it.
-type Packed<'a> = (&'a [u8], usize, usize);
-
-/// The compiled half of `glint.compare`: `glint compare --json`'s figures.
+/// compare(a, b, *, variance_a=None, variance_b=None) -> dict
+///
+/// Compares image a against the reference b with `glint compare --json`'s figures: rmse,
+/// relative_mse, mean_a, mean_b, max_difference, nonfinite_a, nonfinite_b and, given both
+/// variance images (σ²/n, as render(variance=True) returns them), z_test (pass_rate, tested,
+/// alpha, z_of_means, variance_ratio).
 #[pyfunction]
-#[pyo3(signature = (a, b, variance_a=None, variance_b=None))]
+#[pyo3(signature = (a, b, *, variance_a=None, variance_b=None))]
 pub fn compare<'py>(
     py: Python<'py>,
-    a: Packed<'_>,
-    b: Packed<'_>,
-    variance_a: Option<Packed<'_>>,
-    variance_b: Option<Packed<'_>>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+    variance_a: Option<&Bound<'py, PyAny>>,
+    variance_b: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let unpack = |what: &str, p: Packed<'_>| image_from_bytes(what, p.0, p.1, p.2);
-    let (a, b) = (unpack("a", a)?, unpack("b", b)?);
+    let (a, b) = (from_numpy("a", a)?, from_numpy("b", b)?);
     let variances = match (variance_a, variance_b) {
-        (Some(va), Some(vb)) => Some((unpack("variance_a", va)?, unpack("variance_b", vb)?)),
+        (Some(va), Some(vb)) => {
+            Some((from_numpy("variance_a", va)?, from_numpy("variance_b", vb)?))
+        }
         (None, None) => None,
         _ => {
             return Err(PyValueError::new_err(
@@ -109,7 +125,8 @@ pub fn compare<'py>(
             ))
         }
     };
-    let c = compare_images(&a, &b, variances.as_ref().map(|(va, vb)| (va, vb)))
+    let c = py
+        .detach(|| compare_images(&a, &b, variances.as_ref().map(|(va, vb)| (va, vb))))
         .map_err(PyValueError::new_err)?;
     let out = PyDict::new(py);
     out.set_item("width", a.width)?;

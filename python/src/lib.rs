@@ -1,7 +1,7 @@
 //! `glint._glint`: the compiled half of the `glint` Python package (python/glint/). It calls
 //! the `glint` crate for everything: scene loading and validation, the renderers, image files
-//! and comparisons. Images cross the boundary as bytes of little-endian float32 RGB, which the
-//! Python half views as NumPy arrays, so this crate needs no NumPy bindings.
+//! and comparisons. Images cross the boundary as H×W×3 float32 NumPy arrays (the numpy crate):
+//! a render's pixels become the array without a copy.
 
 mod dict_toml;
 mod images;

@@ -2,7 +2,7 @@
 //! bytes) on the device asked for, with the GIL released, Ctrl-C checked between batches, and
 //! one GPU device per process.
 
-use crate::images::image_bytes;
+use crate::images::to_numpy;
 use crate::scene::Scene;
 use crate::SceneError;
 use anyhow::anyhow;
@@ -11,11 +11,11 @@ use glint::error::InputError;
 use glint::gpu::{GpuContext, GpuRenderer};
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use glint::scene::{
-    KernelScene, RenderOverrides, RenderSettings, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+    self as scenes, KernelScene, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
 };
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyByteArray, PyDict};
+use pyo3::types::PyDict;
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, OnceLock};
@@ -35,10 +35,29 @@ fn gpu_context() -> Result<&'static GpuContext, &'static str> {
 }
 
 /// A scene's GPU renderer with its compiled kernel, reused by the next render of the scene
-/// with the same settings.
+/// when only the camera and the per-render settings differ (`same_objects`).
 pub struct GpuCache {
-    settings: (RenderSettings, bool),
+    /// The scene the renderer was made for (its objects, image size and features).
+    scene: scenes::Scene,
+    /// Whether its kernel accumulates AOVs.
+    aovs: bool,
     renderer: GpuRenderer<'static>,
+}
+
+/// Whether a renderer made for `a` renders `b` once given `b`'s parameters: everything but
+/// the camera, spp, seed, max_bounces, the background and light sampling (all in `Params`)
+/// is the same.
+fn same_objects(a: &scenes::Scene, b: &scenes::Scene) -> bool {
+    a.render.width == b.render.width
+        && a.render.height == b.render.height
+        && a.render.russian_roulette == b.render.russian_roulette
+        && a.materials == b.materials
+        && a.spheres == b.spheres
+        && a.quads == b.quads
+        && a.lights == b.lights
+        && a.environment == b.environment
+        && a.textures == b.textures
+        && a.triangles == b.triangles
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -104,6 +123,8 @@ struct Rendered {
     mean: glint::output::Image,
     variance: Option<glint::output::Image>,
     aovs: Option<glint::aov::Aovs>,
+    /// With denoise: OIDN's image of `mean` and the seconds it took.
+    denoised: Option<(glint::output::Image, f64)>,
     spp: u32,
     seconds: f64,
     stopped_by: &'static str,
@@ -111,11 +132,15 @@ struct Rendered {
     nonfinite_samples: u64,
     device: String,
     backend: String,
+    /// Whether a GPU render reused the scene's renderer and kernel from its last render.
+    kernel_reused: bool,
 }
 
 struct Options {
     variance: bool,
+    /// Accumulate AOVs (asked for, or for the denoiser).
     aovs: bool,
+    denoise: bool,
     time_limit: Option<Duration>,
     progress: bool,
 }
@@ -165,12 +190,22 @@ fn run(
         (Some(v), true) => relative_error(&mean, v),
         _ => None,
     };
+    let aovs = if options.aovs {
+        Some(renderer.read_aovs()?)
+    } else {
+        None
+    };
+    let denoised = match (&aovs, options.denoise) {
+        (Some(aovs), true) => {
+            let started = Instant::now();
+            let image = glint::denoise::oidn()?.denoise(&mean, aovs)?;
+            Some((image, started.elapsed().as_secs_f64()))
+        }
+        _ => None,
+    };
     Ok(Rendered {
-        aovs: if options.aovs {
-            Some(renderer.read_aovs()?)
-        } else {
-            None
-        },
+        aovs,
+        denoised,
         variance: if options.variance { variance } else { None },
         mean,
         spp: stats.spp,
@@ -180,47 +215,55 @@ fn run(
         nonfinite_samples: renderer.nonfinite_samples(),
         device: renderer.device_name(),
         backend: renderer.backend_name(),
+        kernel_reused: false,
     })
 }
 
-/// Renders on the GPU, reusing the scene's renderer (and its compiled kernel) when the
-/// settings are the same as last time.
+/// Renders on the GPU, reusing the scene's renderer (and its compiled kernel) when it was
+/// made for the same objects, image size and features.
 fn run_gpu(
     ctx: &'static GpuContext,
     scene: &Scene,
-    kernel_scene: &KernelScene,
-    settings: (RenderSettings, bool),
+    (validated, kernel_scene): (&scenes::Scene, &KernelScene),
     options: &Options,
     stop: &'static AtomicBool,
     signal_error: &mut Option<PyErr>,
 ) -> anyhow::Result<Rendered> {
     let mut cache = scene.gpu.lock().unwrap_or_else(|e| e.into_inner());
-    match cache.as_mut() {
-        Some(c) if c.settings == settings => c.renderer.reset()?,
-        _ => {
-            // Dropped first: two renderers' buffers need not fit the device at once.
-            *cache = None;
-            *cache = Some(GpuCache {
-                renderer: GpuRenderer::new(ctx, kernel_scene)?,
-                settings: settings.clone(),
-            });
+    let reused = match cache.as_mut() {
+        Some(c) if (c.aovs || !options.aovs) && same_objects(&c.scene, validated) => {
+            // Fails where the kernel lacks a feature the new parameters turn on.
+            c.renderer.set_params(kernel_scene.params).is_ok()
         }
+        _ => false,
+    };
+    if !reused {
+        // Dropped first: two renderers' buffers need not fit the device at once.
+        *cache = None;
+        *cache = Some(GpuCache {
+            renderer: GpuRenderer::new(ctx, kernel_scene)?,
+            scene: validated.clone(),
+            aovs: options.aovs,
+        });
     }
     let renderer = &mut cache.as_mut().expect("filled above").renderer;
-    let result = run(renderer, settings.0.spp, options, stop, signal_error);
+    let result = run(renderer, validated.render.spp, options, stop, signal_error);
     if result.is_err() {
         // A device error may leave the renderer in any state: the next render makes a new one.
         *cache = None;
     }
-    result
+    result.map(|r| Rendered {
+        kernel_reused: reused,
+        ..r
+    })
 }
 
-/// The compiled half of `glint.render` (python/glint/__init__.py documents it): the image
-/// and the other outputs as float32 bytes, and the statistics.
+/// The compiled half of `glint.render` (python/glint/rendering.py documents it): a dict of
+/// the image and the other outputs as H×W×3 float32 NumPy arrays, and the statistics.
 #[pyfunction]
 #[pyo3(signature = (scene, *, spp=None, width=None, height=None, max_bounces=None, seed=None,
-    light_sampling=None, device="auto", variance=false, aovs=false, time_limit=None,
-    progress=false))]
+    light_sampling=None, device="auto", variance=false, aovs=false, denoise=false,
+    time_limit=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -234,6 +277,7 @@ pub fn render<'py>(
     device: &str,
     variance: bool,
     aovs: bool,
+    denoise: bool,
     time_limit: Option<f64>,
     progress: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -255,25 +299,30 @@ pub fn render<'py>(
         }
         t => t.map(Duration::from_secs_f64),
     };
+    if denoise {
+        // As `glint render --denoise` checks before rendering: the install step when missing.
+        glint::denoise::oidn().map_err(|e| PyRuntimeError::new_err(format!("denoise: {e:#}")))?;
+    }
     let this = scene.get();
     let source = this.source.display().to_string();
-    let scene_with = this
+    let validated = this
         .scene
         .clone()
         .with_overrides(&overrides)
         .map_err(|m| PyValueError::new_err(format!("{source}: {m}")))?;
-    let mut kernel_scene = scene_with
+    let mut kernel_scene = validated
         .try_kernel_scene()
         .map_err(|e| SceneError::new_err(format!("{source}: {e}")))?;
-    kernel_scene.params.aovs = aovs as u32;
-    kernel_scene.params.radiance_clamp = 0.0;
-    let settings = (scene_with.render.clone(), aovs);
     let options = Options {
         variance,
-        aovs,
+        aovs: aovs || denoise,
+        denoise,
         time_limit,
         progress,
     };
+    // As `glint render` sets them without --clamp.
+    kernel_scene.params.aovs = options.aovs as u32;
+    kernel_scene.params.radiance_clamp = 0.0;
 
     let mut signal_error = None;
     let result = py.detach(|| {
@@ -292,15 +341,14 @@ pub fn render<'py>(
             Some(ctx) => run_gpu(
                 ctx,
                 this,
-                &kernel_scene,
-                settings,
+                (&validated, &kernel_scene),
                 &options,
                 stop.0,
                 &mut signal_error,
             ),
             None => run(
                 &mut CpuRenderer::new(&kernel_scene),
-                scene_with.render.spp,
+                validated.render.spp,
                 &options,
                 stop.0,
                 &mut signal_error,
@@ -319,16 +367,7 @@ pub fn render<'py>(
         }
     }
 
-    let out = PyDict::new(py);
-    let bytes = |image: &glint::output::Image| PyByteArray::new(py, &image_bytes(image));
-    out.set_item("image", bytes(&rendered.mean))?;
-    out.set_item("variance", rendered.variance.as_ref().map(bytes))?;
-    if let Some(a) = &rendered.aovs {
-        out.set_item("albedo", bytes(&a.albedo))?;
-        out.set_item("normal", bytes(&a.normal))?;
-        out.set_item("depth", bytes(&a.depth))?;
-    }
-    let r = &scene_with.render;
+    let r = &validated.render;
     let stats = PyDict::new(py);
     let paths = r.width as u64 * r.height as u64 * rendered.spp as u64;
     stats.set_item("scene", &source)?;
@@ -344,13 +383,29 @@ pub fn render<'py>(
         "paths_per_second",
         paths as f64 / rendered.seconds.max(1e-9),
     )?;
-    stats.set_item("wall_seconds", wall.elapsed().as_secs_f64())?;
     stats.set_item("stopped_by", rendered.stopped_by)?;
     stats.set_item("relative_error", rendered.relative_error)?;
     stats.set_item("nonfinite_samples", rendered.nonfinite_samples)?;
     stats.set_item("device", rendered.device)?;
     stats.set_item("backend", rendered.backend)?;
+    stats.set_item("kernel_reused", rendered.kernel_reused)?;
     stats.set_item("samples", (0u32, rendered.spp))?;
+
+    let out = PyDict::new(py);
+    let (image, raw, denoise_seconds) = match rendered.denoised {
+        Some((denoised, seconds)) => (denoised, Some(rendered.mean), Some(seconds)),
+        None => (rendered.mean, None, None),
+    };
+    stats.set_item("denoise_seconds", denoise_seconds)?;
+    out.set_item("image", to_numpy(py, image))?;
+    out.set_item("raw", raw.map(|i| to_numpy(py, i)))?;
+    out.set_item("variance", rendered.variance.map(|i| to_numpy(py, i)))?;
+    if let Some(a) = rendered.aovs {
+        out.set_item("albedo", to_numpy(py, a.albedo))?;
+        out.set_item("normal", to_numpy(py, a.normal))?;
+        out.set_item("depth", to_numpy(py, a.depth))?;
+    }
+    stats.set_item("wall_seconds", wall.elapsed().as_secs_f64())?;
     out.set_item("stats", stats)?;
     Ok(out)
 }
