@@ -8,6 +8,7 @@ import threading
 import time
 
 import numpy as np
+import pytest
 
 import glint
 
@@ -31,6 +32,32 @@ def test_two_threads_rendering_at_once_give_the_sequential_images(cornell):
         t.start()
     for t in threads:
         t.join(timeout=120)
+    for got, want in zip(results, expected):
+        assert got is not None and np.array_equal(got, want)
+
+
+def test_two_threads_rendering_on_the_gpu_at_once(cornell):
+    """Two scenes on the process's one GPU device at once, each with its own renderer: the
+    images are those of renders one after the other."""
+    gpu = {**SETTINGS, "device": "gpu"}
+    scenes = [glint.load(cornell), glint.load(cornell)]
+    try:
+        expected = [glint.render(s, seed=i + 1, **gpu) for i, s in enumerate(scenes)]
+    except RuntimeError as e:
+        pytest.skip(f"no GPU: {e}")
+    results = [None, None]
+    barrier = threading.Barrier(2)
+
+    def work(i):
+        barrier.wait()
+        for _ in range(3):
+            results[i] = glint.render(scenes[i], seed=i + 1, **gpu)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=300)
     for got, want in zip(results, expected):
         assert got is not None and np.array_equal(got, want)
 

@@ -1,6 +1,7 @@
 """A render from Python is the CLI's render: the same bytes on the CPU, the same statistics."""
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -99,3 +100,46 @@ def test_gpu_render_is_repeatable_and_close_to_the_cpu(cornell):
     cpu = glint.render(scene, device="cpu", **SETTINGS)
     # The GPU traces the same paths as the CPU reference; only float rounding differs.
     assert np.allclose(first.image, cpu, rtol=1e-3, atol=1e-3)
+
+
+def gpu_or_skip(scene, **settings):
+    try:
+        return glint.render(scene, device="gpu", full=True, **settings)
+    except RuntimeError as e:
+        pytest.skip(f"no GPU: {e}")
+
+
+def test_a_second_gpu_render_reuses_the_kernel_and_equals_a_fresh_one(cornell):
+    """The scene's renderer and compiled kernel serve its next renders where only the camera
+    or the [render] settings changed; the image is the one a fresh renderer gives."""
+    scene = glint.load(cornell)
+    first = gpu_or_skip(scene, **SETTINGS)
+    assert not first.stats["kernel_reused"]
+    other = {**SETTINGS, "seed": 7, "spp": 3, "max_bounces": 2}
+    second = glint.render(scene, device="gpu", full=True, **other)
+    assert second.stats["kernel_reused"]
+    assert np.array_equal(second.image, glint.render(glint.load(cornell), device="gpu", **other))
+    scene.camera.eye = (278, 278, -600)
+    moved = glint.render(scene, device="gpu", full=True, **SETTINGS)
+    assert moved.stats["kernel_reused"]
+    assert np.array_equal(moved.image, glint.render(glint.load_dict(scene.to_dict(), path=str(cornell)), device="gpu", **SETTINGS))
+    # Another image size or other materials need another renderer.
+    assert not glint.render(scene, device="gpu", full=True, **{**SETTINGS, "width": 8}).stats["kernel_reused"]
+    scene.materials["white"].color = (0.5, 0.5, 0.5)
+    assert not glint.render(scene, device="gpu", full=True, **{**SETTINGS, "width": 8}).stats["kernel_reused"]
+
+
+def test_denoise(cornell):
+    try:
+        result = glint.render(glint.load(cornell), device="cpu", denoise=True, **SETTINGS)
+    except RuntimeError as e:
+        if os.environ.get("GLINT_REQUIRE_OIDN"):
+            raise
+        assert "Open Image Denoise" in str(e)
+        pytest.skip(str(e))
+    plain = glint.render(glint.load(cornell), device="cpu", **SETTINGS)
+    # The raw mean is the render's (AOVs leave it bit for bit the same); the image is OIDN's.
+    assert np.array_equal(result.raw, plain)
+    assert result.image.shape == plain.shape and np.isfinite(result.image).all()
+    assert not np.array_equal(result.image, plain)
+    assert result.stats["denoise_seconds"] > 0
