@@ -18,11 +18,6 @@ import numpy as np
 
 import glint
 
-try:
-    import tomllib
-except ImportError:  # Python < 3.11
-    import tomli as tomllib
-
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 ROUGHNESS = (0.0, 0.2, 0.4, 0.7)
 
@@ -40,17 +35,15 @@ def main():
     parser.add_argument("--size", type=int, default=192)
     args = parser.parse_args()
 
-    with open(ROOT / "scenes" / "cornell.toml", "rb") as f:
-        cornell = tomllib.load(f)
+    scene = glint.load(ROOT / "scenes" / "cornell.toml")
     figure, axes = plt.subplots(1, len(ROUGHNESS), figsize=(3 * len(ROUGHNESS), 3.3))
     for ax, roughness in zip(axes, ROUGHNESS):
-        # The dict is the TOML file's structure: edit it and load it again.
-        cornell["materials"]["mirror"] = {
+        # Edit the scene in place (checked as the file would be), then render it again.
+        scene.materials["mirror"] = {
             "type": "metal",
             "color": [0.95, 0.64, 0.54],  # copper-ish
             "roughness": roughness,
         }
-        scene = glint.load_dict(cornell, path=str(ROOT / "scenes" / "cornell.toml"))
         result = glint.render(scene, spp=args.spp, width=args.size, height=args.size, full=True)
         stats = result.stats
         print(f"roughness {roughness}: {stats['spp']} spp in {stats['seconds']:.2f} s on {stats['device']}")
