@@ -397,6 +397,15 @@ fn check_in_process(text: &str) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Fails unless the in-process worker's last message says it finished with enough valid scenes.
+fn check_worker_report(seed: u64, total: usize, message: &str) {
+    assert!(message.starts_with("done:"), "{message}");
+    eprintln!("fuzz seed {seed}: {message}");
+    let valid: usize = message.split(' ').nth(1).unwrap().parse().unwrap();
+    // The mutations must leave enough scenes valid for the render half to matter.
+    assert!(valid * 10 >= total, "only {valid} valid scenes of {total}");
+}
+
 #[test]
 fn mutated_scenes_never_panic_hang_or_render_non_finite_pixels() {
     let seed = seed();
@@ -444,16 +453,18 @@ fn mutated_scenes_never_panic_hang_or_render_non_finite_pixels() {
     let mut current = 0;
     loop {
         if let Ok(message) = failure_rx.try_recv() {
-            assert!(message.starts_with("done:"), "{message}");
-            eprintln!("fuzz seed {seed}: {message}");
-            let valid: usize = message.split(' ').nth(1).unwrap().parse().unwrap();
-            // The mutations must leave enough scenes valid for the render half to matter.
-            assert!(valid * 10 >= total, "only {valid} valid scenes of {total}");
-            return;
+            return check_worker_report(seed, total, &message);
         }
         match progress_rx.recv_timeout(CASE_TIMEOUT) {
             Ok(n) => current = n,
-            Err(mpsc::RecvTimeoutError::Disconnected) => {}
+            // The worker is gone: its report was sent before it ended, or it died outside
+            // catch_unwind (without this, the loop would spin forever on an empty channel).
+            Err(mpsc::RecvTimeoutError::Disconnected) => {
+                let message = failure_rx.recv().unwrap_or_else(|_| {
+                    panic!("fuzz seed {seed}: the worker died at case {current} without a report; rerun with GLINT_FUZZ_SEED={seed}")
+                });
+                return check_worker_report(seed, total, &message);
+            }
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 panic!("fuzz seed {seed}: case {current} hung (no progress in {CASE_TIMEOUT:?}); rerun with GLINT_FUZZ_SEED={seed}")
             }

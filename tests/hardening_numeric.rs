@@ -677,15 +677,19 @@ fn gpu_and_cpu_agree_on_scenes_of_every_size() {
         let gpu_result = render_image(&mut gpu_renderer, 2, 2);
         let cpu = render_cpu(&scene, 2);
         let per_sample = glint::gpu::loop_budget::loop_iterations_per_sample(&scene);
-        if loop_limit.is_some_and(|limit| per_sample / 2 > limit) {
-            // Even one ray over all spheres and a shadow ray exceed the limit.
-            let e = gpu_result
-                .expect_err("lavapipe cannot render this scene")
-                .to_string();
-            assert!(e.contains("lavapipe"), "{e}");
-            continue;
-        }
-        let gpu_image = gpu_result.unwrap();
+        // Where one sample can exceed lavapipe's loop limit, the driver may end the kernel early
+        // (Mesa 22.3 does at N = 20000; Mesa 25.0 counts its loops differently and renders it):
+        // then the render must be an error naming lavapipe, never a wrong image. Any image that
+        // comes back must agree with the CPU's.
+        let gpu_image = match gpu_result {
+            Err(e) if loop_limit.is_some_and(|limit| per_sample / 2 > limit) => {
+                let e = e.to_string();
+                assert!(e.contains("lavapipe"), "{e}");
+                eprintln!("{n} spheres: refused as expected on this driver: {e}");
+                continue;
+            }
+            result => result.unwrap(),
+        };
         let (mc, mg) = (cpu.mean(), gpu_image.mean());
         eprintln!("{n} spheres: CPU mean {mc:.5}, GPU mean {mg:.5}");
         let mut agreement = PathAgreement::default();
