@@ -15,6 +15,11 @@ from ._glint import SceneError, compare, read, write
 from .rendering import AOV_NAMES, RenderResult, render
 from .scene import Scene, Table, TableArray, load, load_dict, load_string
 
+# A SceneError's parts, where it has them (a scene file's error has all; one found while
+# laying the scene out for a render has only its message).
+SceneError.path = SceneError.line = SceneError.column = SceneError.field = None
+SceneError.message = None
+
 __all__ = [
     "AOV_NAMES",
     "Scene",

@@ -132,3 +132,11 @@ def test_a_scene_with_array_meshes_stays_editable(root):
     assert repr(scene).endswith(" 1 triangles>")
     with pytest.raises(ValueError, match="vertices and indices go together"):
         scene.meshes[0] = {"vertices": vertices, "material": "red"}
+
+
+def test_scene_error_parts_default_to_none(tmp_path):
+    assert glint.SceneError("x").field is None and glint.SceneError("x").line is None
+    missing = tmp_path / "missing.toml"
+    with pytest.raises(glint.SceneError) as error:
+        glint.load(missing)
+    assert (error.value.path, error.value.line, error.value.field) == (str(missing), None, None)
