@@ -87,7 +87,12 @@ fn hit_comes_first(t: f32, reference: u32, best_t: f32, best_reference: u32) -> 
     return t < best_t || (t == best_t && reference < best_reference);
 }
 
+// The structure is the host's choice, compiled in: ray queries (USE_RAY_QUERY,
+// shaders/traverse/hardware.wgsl), the BVH (USE_BVH, shaders/bvh.wgsl), or the scan.
 fn closest_primitive(ray: Ray) -> ClosestPrimitive {
+    if USE_RAY_QUERY {
+        return hardware_closest_primitive(ray);
+    }
     if USE_BVH {
         return bvh_closest_primitive(ray);
     }
@@ -129,6 +134,9 @@ fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
     if HAS_ENVIRONMENT && primitive == PRIMITIVE_ENVIRONMENT {
         return escapes(ray);
     }
+    if USE_RAY_QUERY {
+        return hardware_first_hit_is(ray, primitive, index);
+    }
     if USE_BVH {
         return bvh_first_hit_is(ray, primitive, index);
     }
@@ -138,6 +146,9 @@ fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
 
 // Whether ray leaves the scene without hitting anything (it then sees the environment).
 fn escapes(ray: Ray) -> bool {
+    if USE_RAY_QUERY {
+        return hardware_escapes(ray);
+    }
     if USE_BVH {
         return bvh_escapes(ray);
     }

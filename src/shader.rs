@@ -55,6 +55,10 @@ pub const SHADER_PARTS: [(&str, &str); 25] = [
 ];
 
 const SCENE_STORAGE: &str = include_str!("../shaders/scene_storage.wgsl");
+/// The hardware traversal (ray queries), in the hardware variant only.
+const TRAVERSE_HARDWARE: &str = include_str!("../shaders/traverse/hardware.wgsl");
+/// Its entry points as stubs, in every other variant.
+const TRAVERSE_SOFTWARE_ONLY: &str = include_str!("../shaders/traverse/software_only.wgsl");
 const SCENE_UNIFORM: &str = include_str!("../shaders/scene_uniform.wgsl");
 
 /// Name of the compute entry point in `shaders/trace.wgsl`.
@@ -78,6 +82,12 @@ pub enum SceneBinding {
     /// traversal stack holds `stack_size` entries: enough for the tree
     /// ([`crate::scene::bvh::kernel_stack_size`]).
     Bvh { uniform_nodes: u32, stack_size: u32 },
+    /// Storage buffers traced with the device's ray queries
+    /// (`shaders/traverse/hardware.wgsl`) against an acceleration structure the host builds
+    /// (`src/gpu/acceleration.rs`): only on devices with `wgpu::Features::EXPERIMENTAL_RAY_QUERY`,
+    /// where a kernel with ray queries compiles. Chosen by `--traversal` (`src/gpu/traversal.rs`),
+    /// never by [`SceneBinding::for_scene`].
+    Hardware,
 }
 
 /// How many of the BVH's top nodes the kernel reads from a uniform buffer on a device whose
@@ -154,7 +164,7 @@ impl SceneBinding {
     pub fn uniform_node_count(&self) -> u32 {
         match self {
             SceneBinding::Bvh { uniform_nodes, .. } => *uniform_nodes,
-            SceneBinding::Storage | SceneBinding::Uniform(_) => 1,
+            SceneBinding::Storage | SceneBinding::Uniform(_) | SceneBinding::Hardware => 1,
         }
     }
 
@@ -163,7 +173,7 @@ impl SceneBinding {
     pub fn stack_size(&self) -> u32 {
         match self {
             SceneBinding::Bvh { stack_size, .. } => *stack_size,
-            SceneBinding::Storage | SceneBinding::Uniform(_) => 1,
+            SceneBinding::Storage | SceneBinding::Uniform(_) | SceneBinding::Hardware => 1,
         }
     }
 
@@ -173,7 +183,13 @@ impl SceneBinding {
             SceneBinding::Storage => "storage",
             SceneBinding::Uniform(_) => "uniform",
             SceneBinding::Bvh { .. } => "bvh",
+            SceneBinding::Hardware => "hardware",
         }
+    }
+
+    /// Whether the kernel traces with ray queries: it then needs the device feature.
+    pub fn uses_ray_queries(&self) -> bool {
+        matches!(self, SceneBinding::Hardware)
     }
 
     /// The WGSL declaring the scene's bindings, as a named part.
@@ -185,21 +201,32 @@ impl SceneBinding {
             self.uniform_node_count(),
             self.stack_size()
         );
+        // The traversal's entry points: ray queries in the hardware variant, stubs elsewhere.
+        let hardware = self.uses_ray_queries();
+        let traverse = format!(
+            "const USE_RAY_QUERY: bool = {hardware};\n{}",
+            if hardware {
+                TRAVERSE_HARDWARE
+            } else {
+                TRAVERSE_SOFTWARE_ONLY
+            }
+        );
         let storage = |use_bvh: bool| {
             format!(
                 "const USE_BVH: bool = {use_bvh};\nconst HAS_TRIANGLES: bool = true;\n\
-                 {bvh}{SCENE_STORAGE}"
+                 {bvh}{SCENE_STORAGE}{traverse}"
             )
         };
         match self {
             SceneBinding::Storage => ("scene_storage.wgsl", storage(false)),
             SceneBinding::Bvh { .. } => ("scene_storage.wgsl", storage(true)),
+            SceneBinding::Hardware => ("scene_storage.wgsl", storage(false)),
             SceneBinding::Uniform(c) => (
                 "scene_uniform.wgsl",
                 format!(
                     "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
                      const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
-                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n{bvh}{}",
+                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n{bvh}{}{traverse}",
                     c.spheres, c.quads, c.materials, c.emitters, SCENE_UNIFORM
                 ),
             ),
@@ -376,6 +403,10 @@ pub fn render_kernel_source_for(variant: KernelVariant) -> String {
 pub fn render_kernel_source_with(variant: KernelVariant, params: ParamsBinding) -> String {
     let (scene_name, scene_text) = variant.binding.part();
     let mut source = String::new();
+    // An extension must be enabled before any declaration.
+    if variant.binding.uses_ray_queries() {
+        source += "enable wgpu_ray_query;\n";
+    }
     for (i, (name, text)) in SHADER_PARTS.iter().enumerate() {
         source += &format!("// ---- {name}\n{text}\n");
         if i == 0 {

@@ -6,8 +6,8 @@
 //! coincident copies of spheres, quads and triangles, where only the rule decides the hit.
 
 mod common;
-use common::gpu;
-use common::probe::{run_probe_bvh, ProbeParams};
+use common::probe::{run_probe_bvh, run_probe_hardware, ProbeParams};
+use common::{gpu, gpu_with_ray_queries};
 use glam::Vec3;
 use glint::cpu::intersect::{
     closest_primitive, escapes, first_hit_is, scan_closest_primitive, ClosestPrimitive, Geometry,
@@ -237,9 +237,15 @@ fn check_cpu(
 }
 
 /// The same on the GPU, through the probe kernel (tests/shaders/probe.wgsl): the kernel's BVH
-/// traversal and its scan find the same hit, bit for bit, for 10⁵ rays, and its shadow tests
-/// agree (with `stride` as in [`check_cpu`]). Returns how many rays hit something.
-fn check_gpu(ctx: &glint::gpu::GpuContext, scene: &KernelScene, stride: [u32; 3]) -> u32 {
+/// traversal (or with `hardware`, its ray queries: shaders/traverse/hardware.wgsl) and its scan
+/// find the same hit, bit for bit, for 10⁵ rays, and its shadow tests agree (with `stride` as
+/// in [`check_cpu`]). Returns how many rays hit something.
+fn check_gpu(
+    ctx: &glint::gpu::GpuContext,
+    scene: &KernelScene,
+    stride: [u32; 3],
+    hardware: bool,
+) -> u32 {
     let rays = 100_000u32;
     let params = ProbeParams {
         count: 2 * rays,
@@ -249,23 +255,47 @@ fn check_gpu(ctx: &glint::gpu::GpuContext, scene: &KernelScene, stride: [u32; 3]
         normal: stride.map(|s| s as f32),
         ..Default::default()
     };
-    let out = run_probe_bvh(ctx, "probe_closest_hit", params, scene);
+    let out = if hardware {
+        run_probe_hardware(ctx, "probe_closest_hit", params, scene)
+    } else {
+        run_probe_bvh(ctx, "probe_closest_hit", params, scene)
+    };
     let mut hits = 0;
+    // Every disagreement, so a failure says how many and which rays.
+    let mut wrong = Vec::new();
     for (i, pair) in out.chunks(2).enumerate() {
         let (found, expected) = (pair[0], pair[1]);
-        let hit = |v: [f32; 4]| (v[0].to_bits(), v[1].to_bits(), v[2].to_bits());
-        assert_eq!(hit(found), hit(expected), "ray {i}");
+        let hit = |v: [f32; 4]| (v[0], v[1].to_bits(), v[2].to_bits());
+        if hit(found) != hit(expected) || found[0].to_bits() != expected[0].to_bits() {
+            wrong.push(format!(
+                "ray {i}: found {:?}, expected {:?}",
+                hit(found),
+                hit(expected)
+            ));
+        }
         let flags = found[3] as u32;
         if expected[0] == NO_HIT {
-            assert_eq!(flags, 4, "ray {i}: a miss escapes, and no shadow test ran");
+            if flags != 4 {
+                wrong.push(format!(
+                    "ray {i}: flags {flags}, but a miss escapes, and no shadow test ran"
+                ));
+            }
         } else {
             hits += 1;
-            assert_eq!(
-                flags, 1,
-                "ray {i}: the hit is first, the later primitive behind it"
-            );
+            if flags != 1 {
+                wrong.push(format!(
+                    "ray {i}: flags {flags}, but the hit is first, the later primitive behind it"
+                ));
+            }
         }
     }
+    assert!(
+        wrong.is_empty(),
+        "{} disagreements with the scan in {} rays (hardware: {hardware}), the first: {:#?}",
+        wrong.len(),
+        rays,
+        &wrong[..wrong.len().min(10)]
+    );
     hits
 }
 
@@ -298,7 +328,7 @@ fn every_gpu_traversal_finds_the_lowest_of_coincident_copies() {
     let dir = tempfile::tempdir().unwrap();
     let scene = copies_scene(dir.path());
     for tree in [scene.clone(), with_copies_in_the_tree(&scene)] {
-        let hits = check_gpu(ctx, &tree, COPY_STRIDE);
+        let hits = check_gpu(ctx, &tree, COPY_STRIDE, false);
         assert!(hits > 50_000, "{hits}");
     }
 }
@@ -308,6 +338,34 @@ fn every_gpu_traversal_finds_the_closest_of_a_deep_stack() {
     let Some(ctx) = gpu() else { return };
     let dir = tempfile::tempdir().unwrap();
     let scene = stack_scene(dir.path());
-    let hits = check_gpu(ctx, &scene, [1; 3]);
+    let hits = check_gpu(ctx, &scene, [1; 3], false);
+    assert!(hits > 30_000, "{hits}");
+}
+
+/// The hardware traversal (ray queries against a TLAS, every candidate decided by glint's own
+/// tests and the rule) finds the scan's hit, bit for bit, on the same 10⁵ rays: over the tree's
+/// primitives, and over every copy too, where the hardware proposes coincident candidates in
+/// its own order and only the rule can pick the lowest.
+#[test]
+fn hardware_traversal_finds_the_lowest_of_coincident_copies() {
+    let Some(ctx) = gpu_with_ray_queries() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = copies_scene(dir.path());
+    for tree in [scene.clone(), with_copies_in_the_tree(&scene)] {
+        let hits = check_gpu(ctx, &tree, COPY_STRIDE, true);
+        assert!(hits > 50_000, "{hits}");
+    }
+}
+
+#[test]
+fn hardware_traversal_finds_the_closest_of_a_deep_stack() {
+    let Some(ctx) = gpu_with_ray_queries() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = stack_scene(dir.path());
+    let hits = check_gpu(ctx, &scene, [1; 3], true);
     assert!(hits > 30_000, "{hits}");
 }

@@ -6,7 +6,9 @@
 //! 2000 levels deep, and its depth is bounded too (src/scene/bvh.rs).
 
 mod common;
-use common::{gpu, render_cpu, render_gpu, shipped_scene_text, sized};
+use common::{gpu, gpu_with_ray_queries, render_cpu, render_gpu, shipped_scene_text, sized};
+use glint::gpu::{GpuRenderer, Traversal};
+use glint::render::render_image;
 use glint::scene::{bvh, KernelScene, Scene};
 use std::path::Path;
 
@@ -127,4 +129,28 @@ fn gpu_renders_the_plain_box() {
         render_gpu(ctx, &full, 1).pixels,
         render_gpu(ctx, &plain, 1).pixels
     );
+}
+
+/// With the hardware traversal too: the copies stay invisible, over the tree's primitives (the
+/// copies left out, as for the BVH) and with every copy in the acceleration structure, where
+/// the hardware proposes 2000 coincident spheres and 1001 coincident blocks in its own order
+/// and only the closest-hit rule picks the first. The images are the software traversal's,
+/// bit for bit.
+#[test]
+fn gpu_hardware_traversal_renders_the_plain_box() {
+    let Some(ctx) = gpu_with_ray_queries() else {
+        return;
+    };
+    let render = |scene: &KernelScene, traversal, spp| {
+        let mut renderer = GpuRenderer::with_traversal(ctx, scene, traversal).unwrap();
+        assert_eq!(renderer.traversal(), traversal);
+        render_image(&mut renderer, spp, spp).unwrap().pixels
+    };
+    let plain = cornell_with_block(false, 32, 1);
+    let copies = cornell_with_block(true, 32, 1);
+    let expected = render(&plain, Traversal::Software, 1);
+    assert_eq!(render(&plain, Traversal::Hardware, 1), expected);
+    assert_eq!(render(&copies, Traversal::Hardware, 1), expected);
+    let full = with_copies_in_the_tree(&copies);
+    assert_eq!(render(&full, Traversal::Hardware, 1), expected);
 }

@@ -357,3 +357,42 @@ fn every_feature_combination_validates() {
         }
     }
 }
+
+/// The hardware traversal's variant (ray queries) is valid WGSL with every feature and with
+/// none, and starts by enabling ray queries; no other variant mentions them, so each compiles
+/// on a device without them.
+#[test]
+fn hardware_variant_validates_and_only_it_uses_ray_queries() {
+    let none = KernelFeatures {
+        light_sampling: false,
+        sphere_emitters: false,
+        quad_emitters: false,
+        triangle_emitters: false,
+        metal: false,
+        dielectric: false,
+        pbr: false,
+        aovs: false,
+        textures: false,
+        environment: false,
+        lights: false,
+        sun_disks: false,
+    };
+    for features in [KernelFeatures::ALL, none] {
+        let source = render_kernel_source_for(KernelVariant {
+            binding: SceneBinding::Hardware,
+            features,
+        });
+        assert!(source.starts_with("enable wgpu_ray_query;"));
+        validate_source(source);
+        for binding in [
+            SceneBinding::Storage,
+            SceneBinding::Bvh {
+                uniform_nodes: 1,
+                stack_size: 8,
+            },
+        ] {
+            let source = render_kernel_source_for(KernelVariant { binding, features });
+            assert!(!source.contains("rayQuery") && !source.contains("wgpu_ray_query"));
+        }
+    }
+}

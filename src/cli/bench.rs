@@ -2,7 +2,7 @@
 
 use crate::bench::{case_scene, cases, mesh_cases, run_case, BenchDevice, BenchResult};
 use crate::cpu::renderer::CpuRenderer;
-use crate::gpu::{GpuContext, GpuRenderer};
+use crate::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
 use crate::shader::{SceneBinding, SceneCounts};
 use anyhow::Result;
 use clap::{Args, ValueEnum};
@@ -38,6 +38,10 @@ pub struct BenchArgs {
     /// Where the GPU kernel reads the scene from, to compare the two kernels.
     #[arg(long, value_enum, default_value_t = SceneBindingChoice::Auto)]
     pub scene_binding: SceneBindingChoice,
+    /// How the GPU kernel finds hits: hardware (ray queries; overrides --scene-binding),
+    /// software (glint's BVH or scan), or auto (as for `render`).
+    #[arg(long, value_enum, default_value_t = TraversalChoice::Auto)]
+    pub traversal: TraversalChoice,
     /// Instead of the fixed set: the Cornell box with a generated mesh of about this many
     /// triangles (0: none), at 256² with light sampling, for paths/s against primitive count;
     /// e.g. `--mesh-triangles 0,1000,100000,1000000`.
@@ -52,6 +56,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
         Some(GpuContext::new()?)
     };
     let gpu_name = gpu.as_ref().map(|g| g.device_name());
+    let traversal = match &gpu {
+        Some(ctx) => Some(args.traversal.resolve(ctx)?),
+        None => None,
+    };
     if !args.json {
         crate::outln!(
             "GPU: {}   CPU reference: {} threads   (medians of {} runs after a warm-up)",
@@ -71,6 +79,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let result = match (case.device, &gpu) {
             (BenchDevice::Gpu, Some(ctx)) => {
                 let mut renderer = match args.scene_binding {
+                    _ if traversal == Some(Traversal::Hardware) => {
+                        GpuRenderer::with_traversal(ctx, &scene, Traversal::Hardware)?
+                    }
                     SceneBindingChoice::Auto => GpuRenderer::new(ctx, &scene)?,
                     SceneBindingChoice::Storage => {
                         GpuRenderer::with_scene_binding(ctx, &scene, SceneBinding::Storage)?
@@ -109,6 +120,11 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 serde_json::json!({
                     "device": r.case.device.as_str(),
                     "scene_binding": r.scene_binding.map(|b| b.name()),
+                    "traversal": r.scene_binding.map(|b| if b.uses_ray_queries() {
+                        Traversal::Hardware.name()
+                    } else {
+                        Traversal::Software.name()
+                    }),
                     "width": r.case.size,
                     "height": r.case.size,
                     "max_bounces": 8,

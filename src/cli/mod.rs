@@ -3,6 +3,7 @@
 mod bench;
 mod compare;
 mod merge;
+mod model;
 mod post;
 mod render;
 mod render_writer;

@@ -1,11 +1,12 @@
 //! `glint render`.
 
+use super::model::ModelArgs;
 use super::post::PostArgs;
 use super::render_writer::RenderWriter;
 use super::sample_range::{self, SampleRangeArgs};
 use crate::cpu::renderer::CpuRenderer;
 use crate::error::InputError;
-use crate::gpu::{GpuContext, GpuRenderer};
+use crate::gpu::{GpuContext, GpuRenderer, TraversalChoice};
 use crate::interrupt::{self, Interrupted};
 use crate::output::ImageFormat;
 use crate::output_check::OutputSet;
@@ -13,9 +14,9 @@ use crate::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
     relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
 };
-use crate::scene::{
-    KernelScene, RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
-};
+use crate::scene::model::ModelScene;
+use crate::scene::model_toml::model_toml;
+use crate::scene::{KernelScene, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use crate::shader_types::Params;
 use anyhow::Result;
 use clap::Args;
@@ -30,7 +31,7 @@ const BATCH_TARGET: Duration = Duration::from_millis(250);
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file (TOML).
+    /// Scene file (TOML), or a model file (.glb, .gltf, .obj, .ply) to render as a scene.
     pub scene: PathBuf,
     /// Output image: .png (clamped, sRGB) or .exr (linear float32 radiance). Default: <scene stem>.png
     #[arg(short, long)]
@@ -59,6 +60,11 @@ pub struct RenderArgs {
     /// Render on a Vulkan GPU or fail; without it, no GPU means a CPU render.
     #[arg(long)]
     pub gpu: bool,
+    /// How the GPU kernel finds hits: the device's ray queries (hardware), glint's own BVH
+    /// (software), or auto: hardware where the device has ray queries, but not on lavapipe
+    /// (no faster there). The CPU reference always uses its BVH.
+    #[arg(long, value_enum, default_value_t = TraversalChoice::Auto)]
+    pub traversal: TraversalChoice,
     /// Stop at the first batch boundary after this many seconds and write what is done.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
@@ -78,6 +84,12 @@ pub struct RenderArgs {
     pub json: bool,
     #[command(flatten)]
     pub post: PostArgs,
+    #[command(flatten)]
+    pub model: ModelArgs,
+    /// Model files: write the scene glint builds from the file as a scene file (TOML) on
+    /// stdout, and render nothing.
+    #[arg(long)]
+    pub print_scene: bool,
     #[command(flatten)]
     pub range: SampleRangeArgs,
     /// Refresh the output with the running image (a resumable partial file for .exr) every
@@ -134,7 +146,7 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
 
 pub fn run(args: RenderArgs) -> Result<()> {
     let started = Instant::now();
-    let scene = Scene::load(&args.scene).map_err(InputError::from)?;
+    let (scene, model) = args.model.load(&args.scene, args.width, args.height)?;
     let overrides = RenderOverrides {
         width: args.width,
         height: args.height,
@@ -146,6 +158,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let scene = scene
         .with_overrides(&overrides)
         .map_err(|m| InputError(format!("{}: {m}", args.scene.display())))?;
+    if args.print_scene {
+        let Some(model) = model else {
+            return Err(InputError(format!(
+                "--print-scene writes the scene built from a model file; {} is a scene file \
+                 already",
+                args.scene.display()
+            ))
+            .into());
+        };
+        crate::outln!("{}", model_toml(&ModelScene { scene, ..model }).trim_end());
+        return Ok(());
+    }
     let range = &args.range;
     args.post.refuse_partial(
         range.samples.is_some() || range.shard.is_some() || range.resume.is_some(),
@@ -186,9 +210,16 @@ pub fn run(args: RenderArgs) -> Result<()> {
     args.post.check()?;
 
     let gpu = open_gpu(&args)?;
-    let mut renderer: Box<dyn Renderer + '_> = match &gpu {
-        Some(ctx) => Box::new(GpuRenderer::new(ctx, &kernel_scene)?),
-        None => Box::new(CpuRenderer::new(&kernel_scene)),
+    // The CPU reference traverses its BVH whatever --traversal says.
+    let traversal = match &gpu {
+        Some(ctx) => Some(args.traversal.resolve(ctx)?),
+        None => None,
+    };
+    let mut renderer: Box<dyn Renderer + '_> = match (&gpu, traversal) {
+        (Some(ctx), Some(traversal)) => {
+            Box::new(GpuRenderer::with_traversal(ctx, &kernel_scene, traversal)?)
+        }
+        _ => Box::new(CpuRenderer::new(&kernel_scene)),
     };
 
     plan.start(renderer.as_mut())?;
@@ -294,6 +325,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "nonfinite_samples": renderer.nonfinite_samples(),
             "device": renderer.device_name(),
             "backend": renderer.backend_name(),
+            // The GPU's traversal; the CPU reference's is its BVH ("software").
+            "traversal": traversal.unwrap_or(crate::gpu::Traversal::Software).name(),
             "triangles": kernel_scene.triangles.len(),
             "bvh_nodes": kernel_scene.bvh_nodes.len(),
             "bvh_build_seconds": kernel_scene.bvh_build_seconds,

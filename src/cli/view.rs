@@ -1,7 +1,9 @@
 //! `glint view`.
 
+use super::model::ModelArgs;
 use super::tone::ToneArgs;
 use crate::error::InputError;
+use crate::gpu::TraversalChoice;
 use crate::scene::MAX_IMAGE_SIDE;
 use crate::viewer::{action::Script, ViewOptions};
 use anyhow::Result;
@@ -10,7 +12,8 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// Scene file (TOML); edits on disk are picked up while the window is open.
+    /// Scene file (TOML), or a model file (.glb, .gltf, .obj, .ply) to view as a scene; edits
+    /// on disk are picked up while the window is open.
     pub scene: PathBuf,
     /// Window and image width in pixels (overrides [render] width).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=MAX_IMAGE_SIDE as i64), allow_negative_numbers = true)]
@@ -27,8 +30,14 @@ pub struct ViewArgs {
     /// On exit, write what is shown (.png) or the linear mean radiance (.exr).
     #[arg(long, value_name = "FILE")]
     pub screenshot: Option<PathBuf>,
+    /// How the kernel finds hits: hardware (ray queries), software (glint's BVH) or auto (as
+    /// for `render`).
+    #[arg(long, value_enum, default_value_t = TraversalChoice::Auto)]
+    pub traversal: TraversalChoice,
     #[command(flatten)]
     pub tone: ToneArgs,
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Tests: actions to inject before given frames, e.g. "5:orbit 40 0; 10:reload".
     #[arg(long, hide = true)]
     pub script: Option<String>,
@@ -42,7 +51,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
         Some(text) => Script::parse(text).map_err(|e| InputError(format!("--script: {e}")))?,
         None => Script::default(),
     };
+    args.model.refuse_for_scene_file(&args.scene)?;
     crate::viewer::run(ViewOptions {
+        model: args.model.options(args.width, args.height),
         scene: args.scene,
         width: args.width,
         height: args.height,
@@ -52,5 +63,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
         display: args.tone.transform(),
         script,
         log_frames: args.log_frames,
+        traversal: args.traversal,
     })
 }

@@ -27,21 +27,48 @@ pub fn compute_bind_group(
     label: &str,
     buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
-    let entries: Vec<_> = buffers
+    compute_bind_group_with_tlas(device, label, buffers, None)
+}
+
+/// [`compute_bind_group`] with an acceleration structure bound too, where one is given (the
+/// hardware traversal's: shaders/traverse/hardware.wgsl).
+pub fn compute_bind_group_with_tlas(
+    device: &wgpu::Device,
+    label: &str,
+    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
+    tlas: Option<(u32, &wgpu::Tlas)>,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let mut entries: Vec<_> = buffers
         .iter()
         .map(|&(binding, ty, _)| buffer_layout_entry(binding, ty, wgpu::ShaderStages::COMPUTE))
         .collect();
+    if let Some((binding, _)) = tlas {
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::AccelerationStructure {
+                vertex_return: false,
+            },
+            count: None,
+        });
+    }
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some(label),
         entries: &entries,
     });
-    let entries: Vec<_> = buffers
+    let mut entries: Vec<_> = buffers
         .iter()
         .map(|&(binding, _, buffer)| wgpu::BindGroupEntry {
             binding,
             resource: buffer.as_entire_binding(),
         })
         .collect();
+    if let Some((binding, tlas)) = tlas {
+        entries.push(wgpu::BindGroupEntry {
+            binding,
+            resource: tlas.as_binding(),
+        });
+    }
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
         layout: &layout,

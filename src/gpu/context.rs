@@ -81,12 +81,26 @@ impl GpuContext {
             )));
         }
         // wgpu's default limits are below what lavapipe and desktop GPUs offer (e.g. the
-        // 128 MiB storage binding the accumulation buffer may need): ask for the adapter's own.
-        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        // 128 MiB storage binding the accumulation buffer may need): ask for the adapter's own,
+        // acceleration-structure limits included (lavapipe allows 2²⁴ − 1 primitives per BLAS,
+        // below wgpu's minimum defaults for ray queries).
+        // Ray queries where the adapter has them, for the hardware traversal (--traversal).
+        let features = adapter.features()
+            & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::EXPERIMENTAL_RAY_QUERY);
+        let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("glint"),
             required_features: features,
-            required_limits: adapter.limits(),
+            required_limits: limits.clone().using_acceleration_structure_values(limits),
+            // SAFETY: the one experimental feature asked for is ray queries, used only by the
+            // hardware traversal's kernel variant and its acceleration structure
+            // (src/gpu/acceleration.rs), tested against the software traversal
+            // (tests/hardware_traversal.rs).
+            experimental_features: if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
+                unsafe { wgpu::ExperimentalFeatures::enabled() }
+            } else {
+                wgpu::ExperimentalFeatures::disabled()
+            },
             ..Default::default()
         }))
         .map_err(|e| GpuUnavailable(format!("cannot open {}: {e}", adapter_info.name)))?;
@@ -147,6 +161,12 @@ impl GpuContext {
         };
         buffer.unmap();
         Ok(value)
+    }
+
+    /// Whether the device traces with ray queries (the hardware traversal can run).
+    pub fn has_ray_queries(&self) -> bool {
+        self.features
+            .contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY)
     }
 
     /// Blocks until all submitted work is done.

@@ -47,6 +47,18 @@ pub fn loop_iterations_per_sample(scene: &KernelScene) -> u64 {
     sample_iterations(&scene.params, loop_iterations_per_ray(scene))
 }
 
+/// [`loop_iterations_per_sample`] for the hardware traversal (shaders/traverse/hardware.wgsl),
+/// whose candidate loop runs once per primitive proposed (each at most once) and whose
+/// driver, on lavapipe, walks its own tree in loops of the same shader: per ray, three per
+/// primitive, a bound on a tree's nodes and candidates for any tree of at least two children
+/// per node.
+pub fn hardware_loop_iterations_per_sample(scene: &KernelScene) -> u64 {
+    let params = &scene.params;
+    let primitives =
+        params.sphere_count as u64 + params.quad_count as u64 + params.triangle_count as u64;
+    sample_iterations(params, 3 * primitives + 1)
+}
+
 fn sample_iterations(params: &Params, per_ray: u64) -> u64 {
     let segments = params.max_bounces as u64 + 1;
     segments * (2 * per_ray + params.light_count as u64 + 1)

@@ -1,5 +1,6 @@
 //! The GPU path: wgpu on Vulkan, running the WGSL kernel in `shaders/`.
 
+pub mod acceleration;
 pub mod binding;
 pub mod context;
 pub mod inline_uniforms;
@@ -7,6 +8,8 @@ pub mod limits;
 pub mod loop_budget;
 pub mod renderer;
 pub mod tiles;
+pub mod traversal;
 
 pub use context::{GpuContext, GpuUnavailable};
 pub use renderer::GpuRenderer;
+pub use traversal::{Traversal, TraversalChoice};

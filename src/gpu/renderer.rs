@@ -1,13 +1,16 @@
 //! The GPU renderer: scene upload, sample batches, readback of the running sums.
 
-use super::binding::{compute_bind_group, compute_pipeline};
+use super::acceleration::AccelerationStructure;
+use super::binding::{compute_bind_group_with_tlas, compute_pipeline};
 use super::context::GpuContext;
 use super::inline_uniforms::params_binding_for;
 use super::limits::{check_buffers, BufferBinding, BufferNeed};
 use super::loop_budget::{
-    device_loop_limit, loop_iterations_per_sample, max_samples_per_dispatch, LAVAPIPE_LOOP_LIMIT,
+    device_loop_limit, hardware_loop_iterations_per_sample, loop_iterations_per_sample,
+    max_samples_per_dispatch, LAVAPIPE_LOOP_LIMIT,
 };
 use super::tiles::{next_tile, TilePlanner};
+use super::traversal::Traversal;
 use crate::accumulation::Accumulation;
 use crate::aov::Aovs;
 use crate::output::Image;
@@ -54,6 +57,8 @@ pub struct GpuRenderer<'a> {
     loop_limit: Option<u64>,
     /// The scene's worst case of loop iterations per sample (src/gpu/loop_budget.rs).
     loop_iterations: u64,
+    /// The hardware traversal's acceleration structure, bound with the kernel (kept alive).
+    _acceleration: Option<AccelerationStructure>,
 }
 
 /// Wanted duration of one GPU submission: a batch longer than this is split into tiles.
@@ -116,6 +121,19 @@ impl<'a> GpuRenderer<'a> {
         Self::with_variant(ctx, scene, KernelVariant::for_scene(scene, max_uniform))
     }
 
+    /// A renderer tracing rays with `traversal`: [`GpuRenderer::new`]'s kernel for the
+    /// software one, the hardware variant ([`SceneBinding::Hardware`]) for ray queries.
+    pub fn with_traversal(
+        ctx: &'a GpuContext,
+        scene: &KernelScene,
+        traversal: Traversal,
+    ) -> Result<GpuRenderer<'a>> {
+        match traversal {
+            Traversal::Software => Self::new(ctx, scene),
+            Traversal::Hardware => Self::with_scene_binding(ctx, scene, SceneBinding::Hardware),
+        }
+    }
+
     /// A renderer with the scene bound as `scene_binding` says and the scene's features (tests
     /// and benchmarks compare the bindings).
     pub fn with_scene_binding(
@@ -156,7 +174,7 @@ impl<'a> GpuRenderer<'a> {
         };
         let uniform_nodes = variant.binding.uniform_node_count();
         let (usage, scene_type) = match variant.binding {
-            SceneBinding::Storage | SceneBinding::Bvh { .. } => (
+            SceneBinding::Storage | SceneBinding::Bvh { .. } | SceneBinding::Hardware => (
                 wgpu::BufferUsages::STORAGE,
                 wgpu::BufferBindingType::Storage { read_only: true },
             ),
@@ -296,7 +314,17 @@ impl<'a> GpuRenderer<'a> {
             ParamsBinding::Uniform => wgpu::BufferBindingType::Uniform,
             ParamsBinding::Storage => read_only,
         };
-        let (bind_group_layout, bind_group) = compute_bind_group(
+        // The hardware traversal's structure: references at 27, the TLAS at 26.
+        let acceleration = if variant.binding.uses_ray_queries() {
+            Some(super::acceleration::build(ctx, scene)?)
+        } else {
+            None
+        };
+        let hardware_buffers: Vec<_> = acceleration
+            .iter()
+            .map(|a| (27, read_only, &a.references))
+            .collect();
+        let (bind_group_layout, bind_group) = compute_bind_group_with_tlas(
             device,
             "scene",
             &[
@@ -324,7 +352,11 @@ impl<'a> GpuRenderer<'a> {
                 (19, read_only, &environment_alias),
                 (24, read_only, &lights),
                 (25, read_only, &ggx_energy),
-            ],
+            ]
+            .into_iter()
+            .chain(hardware_buffers)
+            .collect::<Vec<_>>(),
+            acceleration.as_ref().map(|a| (26, &a.tlas)),
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("glint render kernel"),
@@ -361,7 +393,12 @@ impl<'a> GpuRenderer<'a> {
             nonfinite_readback,
             nonfinite: 0,
             loop_limit: device_loop_limit(&ctx.adapter_info),
-            loop_iterations: loop_iterations_per_sample(scene),
+            loop_iterations: if variant.binding.uses_ray_queries() {
+                hardware_loop_iterations_per_sample(scene)
+            } else {
+                loop_iterations_per_sample(scene)
+            },
+            _acceleration: acceleration,
         };
         renderer.warm_up()?;
         Ok(renderer)
@@ -468,6 +505,15 @@ impl<'a> GpuRenderer<'a> {
     /// Where the kernel reads the scene from.
     pub fn scene_binding(&self) -> SceneBinding {
         self.variant.binding
+    }
+
+    /// The traversal the kernel runs.
+    pub fn traversal(&self) -> Traversal {
+        if self.variant.binding.uses_ray_queries() {
+            Traversal::Hardware
+        } else {
+            Traversal::Software
+        }
     }
 
     /// The kernel variant this renderer runs.

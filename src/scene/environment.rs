@@ -47,7 +47,20 @@ pub fn luminance(c: [f32; 3]) -> f64 {
 /// caller to place after the file and field: unreadable or 0×0 images, and texels that are
 /// not finite radiances (with the texel's position), fail.
 pub fn load(path: &Path, strength: f32, rotate_degrees: f32) -> Result<Environment, String> {
-    let mut image = load_linear_image(path, Encoding::Srgb)?;
+    from_image(
+        load_linear_image(path, Encoding::Srgb)?,
+        strength,
+        rotate_degrees,
+    )
+}
+
+/// An environment from a map already in memory (a file's, or the generated studio map of
+/// `studio.rs`), checked and scaled as [`load`] does.
+pub fn from_image(
+    mut image: LinearImage,
+    strength: f32,
+    rotate_degrees: f32,
+) -> Result<Environment, String> {
     for (k, texel) in image.texels.iter_mut().enumerate() {
         let (x, y) = (k as u32 % image.width, k as u32 / image.width);
         if texel.iter().any(|c| !c.is_finite() || *c < 0.0) {

@@ -70,10 +70,15 @@ pub(super) struct SceneToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct CameraToml {
-    pub(super) eye: S<Triple>,
-    pub(super) target: S<Triple>,
-    pub(super) up: S<Triple>,
-    pub(super) vfov: S<Real>,
+    /// `eye`, `target`, `up` and `vfov`, or `from` (with `index`).
+    pub(super) eye: Option<S<Triple>>,
+    pub(super) target: Option<S<Triple>>,
+    pub(super) up: Option<S<Triple>>,
+    pub(super) vfov: Option<S<Real>>,
+    /// A glTF file (relative to the scene file's folder) whose camera this is.
+    pub(super) from: Option<S<String>>,
+    /// Which of its cameras (in node order); without it, the first perspective one.
+    pub(super) index: Option<S<i64>>,
     pub(super) aperture: Option<S<Real>>,
     pub(super) focus_distance: Option<S<Real>>,
 }
@@ -143,6 +148,8 @@ pub(super) struct MeshToml {
     pub(super) rotate: Option<S<Triple>>,
     pub(super) scale: Option<S<ScaleToml>>,
     pub(super) smooth: Option<bool>,
+    /// Whether the file's punctual lights (glTF `KHR_lights_punctual`) join the scene.
+    pub(super) lights: Option<bool>,
 }
 
 /// `scale = 2.0` or `scale = [1.0, 2.0, 1.0]`.
@@ -157,8 +164,10 @@ pub(super) enum ScaleToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct EnvironmentToml {
-    /// Relative to the scene file's folder.
-    pub(super) file: S<String>,
+    /// Relative to the scene file's folder; or `preset`.
+    pub(super) file: Option<S<String>>,
+    /// A map glint generates: `"studio"` (`src/scene/studio.rs`).
+    pub(super) preset: Option<S<String>>,
     pub(super) strength: Option<S<Real>>,
     /// Degrees about the up (+y) axis.
     pub(super) rotate: Option<S<Real>>,

@@ -15,7 +15,10 @@ mod kernel;
 pub mod light;
 pub mod limits;
 pub mod mesh;
+pub mod model;
+pub mod model_toml;
 pub mod stress;
+pub mod studio;
 pub mod texture;
 mod validate;
 

@@ -11,6 +11,7 @@ use super::{ViewOptions, FRAME_TARGET};
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::output::{Image, ImageFormat};
 use crate::render::{BatchSizer, Renderer};
+use crate::scene::model::load_scene_or_model;
 use crate::scene::{
     place_camera, Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS,
     MAX_SPP,
@@ -47,7 +48,7 @@ pub fn run(
     let display = options.display;
     let mut app = App {
         watch: FileWatch::new(&options.scene),
-        loader: BackgroundLoad::new(&options.scene),
+        loader: BackgroundLoad::new(&options.scene).with_model(options.model.clone()),
         sizer: BatchSizer::new(FRAME_TARGET),
         file_camera: scene.camera.clone(),
         camera: scene.camera.clone(),
@@ -316,7 +317,8 @@ impl App {
             view_formats: vec![],
         };
         surface.configure(&ctx.device, &config);
-        let renderer = GpuRenderer::new(ctx, &self.kernel_scene())?;
+        let traversal = self.options.traversal.resolve(ctx)?;
+        let renderer = GpuRenderer::with_traversal(ctx, &self.kernel_scene(), traversal)?;
         let mut display = DisplayPass::new(&ctx.device, format);
         display.bind(&ctx.device, renderer.mean_buffer());
         crate::errln!(
@@ -348,7 +350,9 @@ impl App {
         let Some(gpu) = self.gpu.as_mut() else {
             return Ok(());
         };
-        gpu.renderer = GpuRenderer::new(gpu.ctx, &kernel_scene)?;
+        // The same traversal as before: the device has not changed.
+        let traversal = gpu.renderer.traversal();
+        gpu.renderer = GpuRenderer::with_traversal(gpu.ctx, &kernel_scene, traversal)?;
         gpu.display
             .bind(&gpu.ctx.device, gpu.renderer.mean_buffer());
         gpu.showing_denoised = false;
@@ -429,7 +433,7 @@ impl App {
 
     /// Re-reads the scene file now (scripted reloads; edits go through [`BackgroundLoad`]).
     fn reload(&mut self) -> Result<()> {
-        let loaded = Scene::load(&self.options.scene);
+        let loaded = load_scene_or_model(&self.options.scene, &self.options.model);
         self.apply_loaded(loaded)
     }
 

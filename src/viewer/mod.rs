@@ -17,7 +17,8 @@ pub mod watch;
 
 use crate::error::InputError;
 use crate::output_check::OutputSet;
-use crate::scene::{RenderOverrides, Scene};
+use crate::scene::model::{load_scene_or_model, ModelOptions};
+use crate::scene::RenderOverrides;
 use crate::tonemap::DisplayTransform;
 use action::Script;
 use anyhow::Result;
@@ -26,7 +27,9 @@ use std::path::PathBuf;
 /// What `glint view` was asked to do.
 #[derive(Debug, Clone)]
 pub struct ViewOptions {
+    /// A scene file, or a model file built into a scene with `model`.
     pub scene: PathBuf,
+    pub model: ModelOptions,
     pub width: Option<u32>,
     pub height: Option<u32>,
     /// Samples per frame; `None` adapts the batch to [`FRAME_TARGET`].
@@ -42,6 +45,8 @@ pub struct ViewOptions {
     pub script: Script,
     /// One JSON line per frame and per event on stdout (tests, measurements).
     pub log_frames: bool,
+    /// `--traversal`: how the kernel finds hits, resolved once the device is open.
+    pub traversal: crate::gpu::TraversalChoice,
 }
 
 /// Wanted duration of a frame's batch of samples: a responsive ~30 frames per second.
@@ -62,7 +67,7 @@ fn display_available() -> bool {
 
 /// Runs the viewer until the window closes, Esc, or `frames`.
 pub fn run(options: ViewOptions) -> Result<()> {
-    let scene = Scene::load(&options.scene).map_err(InputError::from)?;
+    let scene = load_scene_or_model(&options.scene, &options.model).map_err(InputError::from)?;
     let scene = scene
         .with_overrides(&RenderOverrides {
             width: options.width,

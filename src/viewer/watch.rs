@@ -4,6 +4,7 @@
 //! file turns into (a FIFO, a link to `/dev/zero`, a huge file, a stalled network mount), the
 //! window keeps drawing.
 
+use crate::scene::model::{load_scene_or_model, ModelOptions};
 use crate::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
@@ -56,6 +57,8 @@ impl FileWatch {
 /// Loads the scene file on a worker thread, one load at a time.
 pub struct BackgroundLoad {
     path: PathBuf,
+    /// How a model file becomes a scene (a scene file ignores it).
+    model: ModelOptions,
     in_flight: Option<Receiver<Result<Scene, SceneError>>>,
     /// Another edit came while a load was in flight: load again when it is done.
     wanted: bool,
@@ -65,9 +68,16 @@ impl BackgroundLoad {
     pub fn new(path: &Path) -> BackgroundLoad {
         BackgroundLoad {
             path: path.to_owned(),
+            model: ModelOptions::default(),
             in_flight: None,
             wanted: false,
         }
+    }
+
+    /// Loads a model file with these options.
+    pub fn with_model(mut self, model: ModelOptions) -> BackgroundLoad {
+        self.model = model;
+        self
     }
 
     /// Asks for a load of the file as it is now.
@@ -83,9 +93,10 @@ impl BackgroundLoad {
         self.wanted = false;
         let (send, receive) = mpsc::channel();
         let path = self.path.clone();
+        let model = self.model.clone();
         std::thread::spawn(move || {
             // The viewer may have moved on (or quit) by the time the load ends.
-            let _ = send.send(Scene::load(&path));
+            let _ = send.send(load_scene_or_model(&path, &model));
         });
         self.in_flight = Some(receive);
     }

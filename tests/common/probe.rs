@@ -1,7 +1,7 @@
 //! Runs the WGSL sampling routines on the GPU through tests/shaders/probe.wgsl.
 
 use bytemuck::{Pod, Zeroable};
-use glint::gpu::binding::{compute_bind_group, compute_pipeline};
+use glint::gpu::binding::{compute_bind_group_with_tlas, compute_pipeline};
 use glint::gpu::renderer::storage_buffer;
 use glint::gpu::GpuContext;
 use glint::scene::KernelScene;
@@ -62,12 +62,40 @@ pub fn run_probe_bvh(
     run_probe_source(ctx, entry, params, scene, source)
 }
 
+/// [`run_probe`] in the kernel variant that traces with ray queries (the hardware traversal),
+/// against `scene`'s acceleration structure; the device must have ray queries.
+pub fn run_probe_hardware(
+    ctx: &GpuContext,
+    entry: &str,
+    params: ProbeParams,
+    scene: &KernelScene,
+) -> Vec<[f32; 4]> {
+    let variant = KernelVariant {
+        binding: SceneBinding::Hardware,
+        features: KernelFeatures::ALL,
+    };
+    let source = render_kernel_source_for(variant) + PROBE_SOURCE;
+    let acceleration = glint::gpu::acceleration::build(ctx, scene).unwrap();
+    run_probe_with(ctx, entry, params, scene, source, Some(&acceleration))
+}
+
 fn run_probe_source(
     ctx: &GpuContext,
     entry: &str,
     params: ProbeParams,
     scene: &KernelScene,
     source: String,
+) -> Vec<[f32; 4]> {
+    run_probe_with(ctx, entry, params, scene, source, None)
+}
+
+fn run_probe_with(
+    ctx: &GpuContext,
+    entry: &str,
+    params: ProbeParams,
+    scene: &KernelScene,
+    source: String,
+    acceleration: Option<&glint::gpu::acceleration::AccelerationStructure>,
 ) -> Vec<[f32; 4]> {
     let device = &ctx.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -118,7 +146,11 @@ fn run_probe_source(
     // Every scene binding, whichever the entry point uses.
     let read_only = wgpu::BufferBindingType::Storage { read_only: true };
     let read_write = wgpu::BufferBindingType::Storage { read_only: false };
-    let (layout, bind_group) = compute_bind_group(
+    let hardware: Vec<_> = acceleration
+        .iter()
+        .map(|a| (27, read_only, &a.references))
+        .collect();
+    let (layout, bind_group) = compute_bind_group_with_tlas(
         device,
         "probe",
         &[
@@ -141,7 +173,11 @@ fn run_probe_source(
             (19, read_only, &environment_alias),
             (24, read_only, &lights),
             (25, read_only, &ggx_energy),
-        ],
+        ]
+        .into_iter()
+        .chain(hardware)
+        .collect::<Vec<_>>(),
+        acceleration.map(|a| (26, &a.tlas)),
     );
     let pipeline = compute_pipeline(device, entry, &layout, &module, entry);
     let mut encoder = device.create_command_encoder(&Default::default());

@@ -132,7 +132,8 @@ fn probe_emitter_choice(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // The closest-hit rule (tests/closest_hit.rs): rays from points within probe.alpha / 2 per axis
 // of probe.position, aimed at random points of random spheres, quads and triangles (or anywhere),
-// each traced by the BVH and by the scan of every primitive. Needs the BVH kernel variant.
+// each traced by the kernel variant's structure (the BVH, or ray queries in the hardware
+// variant) and by the scan of every primitive. Needs the BVH or the hardware kernel variant.
 // Writes, per ray, two entries: the BVH's closest hit (t, kind, index, as bits) and flags, then
 // the scan's closest hit and 0. The flags: 1 when the BVH's shadow test finds the scan's hit
 // first, 2 when it finds a later primitive of its kind (probe.normal[kind] further on: the next
@@ -163,19 +164,19 @@ fn probe_closest_hit(@builtin(global_invocation_id) id: vec3<u32>) {
         aim = select(mix(t.v0, t.v1, a), t.v2, b < 0.25);
     }
     let ray = Ray(origin, normalize(aim - origin));
-    let found = bvh_closest_primitive(ray);
+    let found = closest_primitive(ray);
     let expected = scan_closest_primitive(ray);
     var flags = 0u;
-    if expected.t != NO_HIT && bvh_first_hit_is(ray, expected.primitive, expected.index) {
+    if expected.t != NO_HIT && first_hit_is(ray, expected.primitive, expected.index) {
         flags |= 1u;
     }
     let kind_count = select(select(triangle_count(), quad_count(), expected.primitive == PRIMITIVE_QUAD), sphere_count(), expected.primitive == PRIMITIVE_SPHERE);
     let stride = u32(probe.normal[min(expected.primitive, 2u)]);
     let next = expected.index + stride;
-    if expected.t != NO_HIT && next < kind_count && bvh_first_hit_is(ray, expected.primitive, next) {
+    if expected.t != NO_HIT && next < kind_count && first_hit_is(ray, expected.primitive, next) {
         flags |= 2u;
     }
-    if bvh_escapes(ray) {
+    if escapes(ray) {
         flags |= 4u;
     }
     probe_out[2u * id.x] = vec4<f32>(found.t, bitcast<f32>(found.primitive), bitcast<f32>(found.index), f32(flags));

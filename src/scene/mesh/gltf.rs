@@ -12,6 +12,7 @@
 //! node is visited once; and the triangles the nodes place and the data decoded stay within
 //! bounds set by the file's real size. Each error names the element (`accessors[3]`).
 
+use super::gltf_nodes::placed_nodes;
 use super::{
     check_emission, check_ior, check_reflectance, one_line, read_mesh_bytes, Geometry, MeshFile,
     MeshPart, MAX_TRIANGLES,
@@ -19,7 +20,7 @@ use super::{
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Material, MaterialKind};
 use base64::Engine as _;
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use gltf::json;
 use json::accessor::{ComponentType, Type};
 use json::mesh::{Mode, Semantic};
@@ -37,7 +38,7 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
 ];
 
 /// Extensions glint reads entirely; any other the file uses gets a warning.
-const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization"];
+const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
 
 /// Decoded vertex data may reach this many bytes per byte of the file's buffers (plus
 /// [`DECODE_SLACK`]): a byte index becomes a u32, a byte normal component an f32. It bounds
@@ -45,7 +46,8 @@ const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_mesh_quantization"];
 const DECODE_RATIO: u64 = 4;
 const DECODE_SLACK: u64 = 1 << 20;
 
-pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
+/// The file's JSON, parsed but not checked, and a `.glb`'s binary chunk.
+pub(super) fn read_document(path: &Path) -> Result<(json::Root, Option<Vec<u8>>), String> {
     let bytes = read_mesh_bytes(path)?;
     // The gltf crate subtracts the header's 12 bytes from a .glb's declared length unchecked.
     if bytes.starts_with(b"glTF")
@@ -61,7 +63,11 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
         .map_err(|e| format!("malformed glTF: {}", one_line(&e.to_string())))?;
     drop(bytes);
     let gltf::Gltf { document, blob } = gltf;
-    let root = document.into_json();
+    Ok((document.into_json(), blob))
+}
+
+pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
+    let (root, blob) = read_document(path)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut warnings = Vec::new();
     check_extensions(&root, &mut warnings)?;
@@ -163,7 +169,7 @@ fn check_extensions(root: &json::Root, warnings: &mut Vec<String>) -> Result<(),
 }
 
 /// "accessor 99 does not exist (the file has 4)", when `index` is out of range.
-fn exists(index: usize, len: usize, kind: &str) -> Result<usize, String> {
+pub(super) fn exists(index: usize, len: usize, kind: &str) -> Result<usize, String> {
     if index < len {
         Ok(index)
     } else {
@@ -334,124 +340,25 @@ struct Instance {
     transform: Mat4,
 }
 
-/// The meshes the scene's nodes place, with each node's world transform. The hierarchy must
-/// be a set of trees, as glTF requires: a node has at most one parent and is never its own
-/// ancestor, so each is visited once (a cycle would otherwise never end, and a node reached
-/// by many paths could multiply its mesh without bound).
+/// The meshes the scene's nodes place, with each node's world transform
+/// (`gltf_nodes.rs` walks the hierarchy).
 fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
-    let nodes = &root.nodes;
-    let n = nodes.len();
-    let mut parent: Vec<Option<usize>> = vec![None; n];
-    for (i, node) in nodes.iter().enumerate() {
-        for (k, child) in node.children.iter().flatten().enumerate() {
-            let c = exists(child.value(), n, "node")
-                .map_err(|e| format!("nodes[{i}].children[{k}]: {e}"))?;
-            if c == i {
-                return Err(format!("nodes[{i}] is its own child"));
-            }
-            if let Some(p) = parent[c] {
-                return Err(format!(
-                    "nodes[{c}] is a child of both nodes[{p}] and nodes[{i}]; a glTF node has at \
-                     most one parent"
-                ));
-            }
-            parent[c] = Some(i);
-        }
+    for (i, node) in root.nodes.iter().enumerate() {
         if let Some(m) = node.mesh {
             exists(m.value(), root.meshes.len(), "mesh")
                 .map_err(|e| format!("nodes[{i}].mesh: {e}"))?;
         }
     }
-    // With one parent at most, following parents from any node either ends at a root or
-    // comes back to a node on the way: a cycle.
-    const NEW: u8 = 0;
-    const ON_CHAIN: u8 = 1;
-    const DONE: u8 = 2;
-    let mut state = vec![NEW; n];
-    for start in 0..n {
-        let mut chain = Vec::new();
-        let mut at = Some(start);
-        while let Some(i) = at {
-            match state[i] {
-                DONE => break,
-                ON_CHAIN => {
-                    // Parent to child: i, then the chain back down to i.
-                    let from = chain.iter().position(|&c| c == i).unwrap_or(0);
-                    let cycle: Vec<usize> = std::iter::once(i)
-                        .chain(chain[from..].iter().rev().copied())
-                        .collect();
-                    let shown: Vec<String> = cycle
-                        .iter()
-                        .take(8)
-                        .map(|c| format!("nodes[{c}]"))
-                        .collect();
-                    return Err(format!(
-                        "nodes[{i}] is its own ancestor: the node hierarchy has a cycle ({}{})",
-                        shown.join(" → "),
-                        if cycle.len() > 8 { " → …" } else { "" }
-                    ));
-                }
-                _ => {}
-            }
-            state[i] = ON_CHAIN;
-            chain.push(i);
-            at = parent[i];
-        }
-        for i in chain {
-            state[i] = DONE;
-        }
-    }
-
-    let s = root.scene.map_or(0, |s| s.value());
-    if root.scenes.is_empty() {
-        return Err("malformed glTF: no scene".to_string());
-    }
-    let scene =
-        &root.scenes[exists(s, root.scenes.len(), "scene").map_err(|e| format!("scene: {e}"))?];
-    let mut listed = vec![false; n];
-    let mut stack = Vec::new();
-    for (k, r) in scene.nodes.iter().enumerate() {
-        let field = format!("scenes[{s}].nodes[{k}]");
-        let r = exists(r.value(), n, "node").map_err(|e| format!("{field}: {e}"))?;
-        if let Some(p) = parent[r] {
-            return Err(format!(
-                "{field}: nodes[{r}] is a child of nodes[{p}]; a scene lists only root nodes"
-            ));
-        }
-        if std::mem::replace(&mut listed[r], true) {
-            return Err(format!("{field}: nodes[{r}] is listed twice"));
-        }
-        stack.push((r, Mat4::IDENTITY));
-    }
-    let mut instances = Vec::new();
-    while let Some((i, parent_transform)) = stack.pop() {
-        let node = &nodes[i];
-        let local = match node.matrix {
-            Some(m) => Mat4::from_cols_array(&m),
-            None => Mat4::from_scale_rotation_translation(
-                Vec3::from(node.scale.unwrap_or([1.0; 3])),
-                Quat::from_array(node.rotation.map_or([0.0, 0.0, 0.0, 1.0], |q| q.0)),
-                Vec3::from(node.translation.unwrap_or([0.0; 3])),
-            ),
-        };
-        let transform = parent_transform * local;
-        if !transform.is_finite() {
-            return Err(format!(
-                "nodes[{i}]: its transform (with its ancestors') is not finite"
-            ));
-        }
-        for child in node.children.iter().flatten() {
-            stack.push((child.value(), transform));
-        }
-        if let Some(mesh) = node.mesh {
-            instances.push(Instance {
-                node: i,
+    Ok(placed_nodes(root)?
+        .into_iter()
+        .filter_map(|placed| {
+            root.nodes[placed.node].mesh.map(|mesh| Instance {
+                node: placed.node,
                 mesh: mesh.value(),
-                transform,
-            });
-        }
-    }
-    Ok(instances)
+                transform: placed.transform,
+            })
+        })
+        .collect())
 }
 
 /// A glTF material as glint's, its colour texture's file, and whether it has other textures:

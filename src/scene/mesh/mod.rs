@@ -3,12 +3,19 @@
 //! table). Everything is checked here, before rendering: unreadable or malformed files, vertices
 //! that are not finite, indices out of range, meshes left with no triangles.
 //!
-//! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`); this file holds what they share: the
+//! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`; a glTF file's node hierarchy, cameras
+//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`); this file holds what they share: the
 //! parts a file yields, the material checks, and turning parts into scene triangles.
 
 mod gltf;
+mod gltf_cameras;
+mod gltf_lights;
+mod gltf_nodes;
 mod obj;
 mod ply;
+
+pub use gltf_cameras::{gltf_camera, no_such_camera, FileCamera};
+pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{TextureSet, TextureUse};
@@ -21,6 +28,16 @@ use std::rc::Rc;
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
 /// fit any GPU's storage binding anyway.
 pub const MAX_TRIANGLES: usize = 1 << 28;
+
+/// Whether `path` names a glTF file (`.gltf`, `.glb`), by its extension.
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| matches!(e.to_string_lossy().to_lowercase().as_str(), "gltf" | "glb"))
+}
+
+/// The start of the error for a part without a material (a model file gives those parts a
+/// default material instead, `src/scene/model.rs`).
+pub const NO_MATERIAL: &str = "the file gives no material for these triangles";
 
 /// Where a mesh goes in the scene: scale, then rotate about x, y, z (degrees), then translate.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,7 +105,7 @@ pub(super) struct MeshFile {
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
-pub(super) struct LoadedMesh {
+pub(crate) struct LoadedMesh {
     pub triangles: Vec<Triangle>,
     /// One line each, for stderr.
     pub warnings: Vec<String>,
@@ -96,7 +113,7 @@ pub(super) struct LoadedMesh {
 
 /// Reads, checks, transforms and materials one mesh file. `scene_materials` receives the file's
 /// own materials when `material` is `None`, named `<file name>/<material name>`.
-pub(super) fn load(
+pub(crate) fn load(
     path: &Path,
     shown: &str,
     transform: &MeshTransform,
@@ -178,7 +195,7 @@ pub(super) fn load(
             None => {
                 let Some(index) = part.material else {
                     return Err(format!(
-                        "{shown}: {}the file gives no material for these triangles; set `material` in [[meshes]]",
+                        "{shown}: {}{NO_MATERIAL}; set `material` in [[meshes]]",
                         part_prefix(&part.name)
                     ));
                 };

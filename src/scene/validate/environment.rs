@@ -3,6 +3,7 @@
 use super::super::environment::{self, Environment};
 use super::super::file::{EnvironmentToml, S};
 use super::super::limits::MAX_RADIANCE;
+use super::super::studio;
 use super::fields::{fail, real, FieldError};
 use std::path::Path;
 
@@ -49,15 +50,47 @@ pub(super) fn validate_environment(
         }
         None => 0.0,
     };
-    let file = e.file.get_ref();
-    if file.is_empty() {
-        return fail(e_span, "environment.file", "must name an image file");
-    }
-    environment::load(&folder.join(file), strength, rotate).or_else(|message| {
-        fail(
-            e.file.span(),
+    match (&e.file, &e.preset) {
+        (Some(_), Some(preset)) => fail(
+            preset.span(),
+            "environment.preset",
+            "give either file (a map) or preset (a map glint generates), not both",
+        ),
+        (None, None) => fail(
+            e_span,
             "environment.file",
-            format!("{file}: {message}"),
-        )
-    })
+            format!(
+                "missing: [environment] needs file (an image) or preset = \"{}\"",
+                studio::PRESET
+            ),
+        ),
+        (None, Some(preset)) => {
+            if preset.get_ref() != studio::PRESET {
+                return fail(
+                    preset.span(),
+                    "environment.preset",
+                    format!(
+                        "unknown preset {:?}; known: \"{}\"",
+                        preset.get_ref(),
+                        studio::PRESET
+                    ),
+                );
+            }
+            studio::environment(strength, rotate)
+                .or_else(|message| fail(preset.span(), "environment.preset", message))
+        }
+        (Some(file_span), None) => {
+            let file = file_span.get_ref();
+            if file.is_empty() {
+                return fail(e_span, "environment.file", "must name an image file");
+            }
+            environment::load(&folder.join(file), strength, rotate).or_else(|message| {
+                fail(
+                    file_span.span(),
+                    "environment.file",
+                    format!("{file}: {message}"),
+                )
+            })
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //! case checked, each failure tied to its field and its place in the file. The camera and the
 //! render settings are checked here; each other part of the file in its own module.
 
+mod camera;
 mod environment;
 mod fields;
 mod lights;
@@ -11,14 +12,8 @@ mod objects;
 pub(super) use fields::FieldError;
 
 use super::file::SceneToml;
-use super::limits::{MIN_LENGTH, MIN_SINE};
-use super::{
-    check_image_size, Camera, RenderSettings, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
-};
-use fields::{
-    coordinates, fail, int_in, length_in_range, non_negative, radiance_in_range, real,
-    sine_between, vec3,
-};
+use super::{check_image_size, RenderSettings, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use fields::{fail, int_in, non_negative, radiance_in_range};
 use glam::Vec3;
 use std::path::Path;
 
@@ -40,6 +35,7 @@ impl SceneToml {
                 "missing: the scene needs a [camera] table".into(),
             )
         })?;
+        let camera_span = camera.span();
         let camera = camera.into_inner();
         let render = self.render.ok_or_else(|| {
             whole(
@@ -50,63 +46,7 @@ impl SceneToml {
         let render_span = render.span();
         let render = render.into_inner();
 
-        let eye = coordinates(&camera.eye, "camera.eye")?;
-        let target = coordinates(&camera.target, "camera.target")?;
-        let up = vec3(&camera.up, "camera.up")?;
-        let vfov = real(&camera.vfov, "camera.vfov")?;
-        if !(vfov > 0.0 && vfov < 180.0) {
-            return fail(
-                camera.vfov.span(),
-                "camera.vfov",
-                format!("must be in (0, 180) degrees, got {vfov}"),
-            );
-        }
-        let view = target - eye;
-        if view.as_dvec3().length() == 0.0 {
-            return fail(
-                camera.target.span(),
-                "camera.target",
-                "must differ from camera.eye (the view direction is target − eye)",
-            );
-        }
-        if up == Vec3::ZERO || sine_between(up, view) <= MIN_SINE {
-            return fail(
-                camera.up.span(),
-                "camera.up",
-                format!(
-                    "must not be zero or parallel to the view direction {}",
-                    view.normalize()
-                ),
-            );
-        }
-        let aperture = match &camera.aperture {
-            Some(a) => {
-                let v = real(a, "camera.aperture")?;
-                if v < 0.0 {
-                    return fail(
-                        a.span(),
-                        "camera.aperture",
-                        format!("the lens diameter must be ≥ 0, got {v}"),
-                    );
-                }
-                length_in_range(a, "camera.aperture", v, 0.0)?
-            }
-            None => 0.0,
-        };
-        let focus_distance = match &camera.focus_distance {
-            Some(f) => {
-                let v = real(f, "camera.focus_distance")?;
-                if v <= 0.0 {
-                    return fail(
-                        f.span(),
-                        "camera.focus_distance",
-                        format!("must be > 0, got {v}"),
-                    );
-                }
-                length_in_range(f, "camera.focus_distance", v, MIN_LENGTH)?
-            }
-            None => view.as_dvec3().length() as f32,
-        };
+        let camera = camera::validate_camera(&camera, camera_span, folder)?;
 
         let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
         check_image_size(width, height).or_else(|m| {
@@ -151,12 +91,9 @@ impl SceneToml {
             Some(e) => {
                 let environment =
                     environment::validate_environment(e, render.background.is_some(), folder)?;
-                if let Some(clamped) = environment.image.clamped {
-                    warnings.push(format!(
-                        "{}: {}",
-                        e.get_ref().file.get_ref(),
-                        clamped.warning()
-                    ));
+                if let (Some(clamped), Some(file)) = (environment.image.clamped, &e.get_ref().file)
+                {
+                    warnings.push(format!("{}: {}", file.get_ref(), clamped.warning()));
                 }
                 Some(environment)
             }
@@ -166,14 +103,7 @@ impl SceneToml {
         warnings.append(&mut textures.warnings);
         let scene = Scene {
             name,
-            camera: Camera {
-                eye,
-                target,
-                up,
-                vfov,
-                aperture,
-                focus_distance,
-            },
+            camera,
             render: RenderSettings {
                 width: width as u32,
                 height: height as u32,
@@ -190,7 +120,11 @@ impl SceneToml {
             triangles: objects.triangles,
             textures,
             environment,
-            lights: lights::validate_lights(&self.lights)?,
+            lights: {
+                let mut all = lights::validate_lights(&self.lights)?;
+                all.extend(objects.lights);
+                all
+            },
         };
         Ok((scene, warnings))
     }

@@ -1,6 +1,7 @@
 //! `[[spheres]]`, `[[quads]]` and `[[meshes]]`: the scene's geometry.
 
 use super::super::file::{MeshToml, QuadToml, ScaleToml, SphereToml, S};
+use super::super::light::Light;
 use super::super::limits::{MIN_LENGTH, MIN_SINE};
 use super::super::mesh::{self, MeshTransform};
 use super::super::{Quad, Sphere, Triangle};
@@ -14,6 +15,8 @@ pub(super) struct Objects {
     pub(super) spheres: Vec<Sphere>,
     pub(super) quads: Vec<Quad>,
     pub(super) triangles: Vec<Triangle>,
+    /// The punctual lights of glTF files (`[[meshes]] lights`, default true).
+    pub(super) lights: Vec<Light>,
     pub(super) warnings: Vec<String>,
 }
 
@@ -84,6 +87,7 @@ pub(super) fn validate_objects(
         });
     }
     let mut triangles = Vec::new();
+    let mut lights = Vec::new();
     let mut warnings = Vec::new();
     for (i, m) in meshes_toml.iter().enumerate() {
         let m = m.get_ref();
@@ -118,14 +122,15 @@ pub(super) fn validate_objects(
             None => None,
         };
         let file = m.file.get_ref();
+        let transform = MeshTransform {
+            scale,
+            rotate_degrees: rotate,
+            translate,
+        };
         let loaded = mesh::load(
             &folder.join(file),
             file,
-            &MeshTransform {
-                scale,
-                rotate_degrees: rotate,
-                translate,
-            },
+            &transform,
             material,
             m.smooth.unwrap_or(true),
             &mut materials.list,
@@ -134,6 +139,14 @@ pub(super) fn validate_objects(
         .or_else(|message| fail(m.file.span(), field("file"), message))?;
         warnings.extend(loaded.warnings);
         triangles.extend(loaded.triangles);
+        if m.lights.unwrap_or(true) && mesh::is_gltf(Path::new(file)) {
+            let (mut file_lights, file_warnings) =
+                mesh::gltf_lights(&folder.join(file), transform.matrix()).or_else(|message| {
+                    fail(m.file.span(), field("file"), format!("{file}: {message}"))
+                })?;
+            lights.append(&mut file_lights);
+            warnings.extend(file_warnings.into_iter().map(|w| format!("{file}: {w}")));
+        }
         if triangles.len() > mesh::MAX_TRIANGLES {
             return fail(
                 m.file.span(),
@@ -149,6 +162,7 @@ pub(super) fn validate_objects(
         spheres,
         quads,
         triangles,
+        lights,
         warnings,
     })
 }
