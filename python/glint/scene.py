@@ -286,13 +286,18 @@ class Scene:
         return repr(self._compiled)
 
 
-def load(path):
-    """load(path) -> Scene
+def load(path, camera=None):
+    """load(path, camera=None) -> Scene
 
-    Reads and validates a scene file (TOML) as `glint render` does. Raises glint.SceneError
-    with the CLI's message (file, line and column, field) for a bad scene; the exception's
-    path, line, column, field and message attributes hold the parts."""
-    return Scene(_glint.load(os.fspath(path)))
+    Reads and validates a scene file (TOML) as `glint render` does, or builds the scene of a
+    model file (.glb, .gltf, .obj, .ply) as `glint render model.glb` does: the file's camera
+    (camera=N is --camera N) or one framing the model, its lights, the studio environment;
+    its structure is the scene file `--print-scene` writes (a framing camera frames the
+    default 512-pixel image: render's width and height resize it without framing again,
+    where `glint render model.glb --width W --height H` frames for W×H). Raises glint.SceneError with the
+    CLI's message (file, line and column, field) for a bad scene; the exception's path,
+    line, column, field and message attributes hold the parts."""
+    return Scene(_glint.load(os.fspath(path), camera))
 
 
 def load_string(text, path="<string>"):

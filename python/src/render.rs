@@ -8,7 +8,7 @@ use crate::SceneError;
 use anyhow::anyhow;
 use glint::cpu::renderer::CpuRenderer;
 use glint::error::InputError;
-use glint::gpu::{GpuContext, GpuRenderer};
+use glint::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use glint::scene::{
     self as scenes, KernelScene, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
@@ -41,6 +41,7 @@ pub struct GpuCache {
     scene: scenes::Scene,
     /// Whether its kernel accumulates AOVs.
     aovs: bool,
+    traversal: Traversal,
     renderer: GpuRenderer<'static>,
 }
 
@@ -58,6 +59,18 @@ fn same_objects(a: &scenes::Scene, b: &scenes::Scene) -> bool {
         && a.environment == b.environment
         && a.textures == b.textures
         && a.triangles == b.triangles
+}
+
+/// `--traversal`'s values.
+fn parse_traversal(s: &str) -> PyResult<TraversalChoice> {
+    match s {
+        "auto" => Ok(TraversalChoice::Auto),
+        "hardware" => Ok(TraversalChoice::Hardware),
+        "software" => Ok(TraversalChoice::Software),
+        _ => Err(PyValueError::new_err(format!(
+            "traversal: expected \"auto\", \"hardware\" or \"software\", got {s:?}"
+        ))),
+    }
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -132,6 +145,7 @@ struct Rendered {
     nonfinite_samples: u64,
     device: String,
     backend: String,
+    traversal: Traversal,
     /// Whether a GPU render reused the scene's renderer and kernel from its last render.
     kernel_reused: bool,
 }
@@ -215,6 +229,7 @@ fn run(
         nonfinite_samples: renderer.nonfinite_samples(),
         device: renderer.device_name(),
         backend: renderer.backend_name(),
+        traversal: Traversal::Software,
         kernel_reused: false,
     })
 }
@@ -225,13 +240,19 @@ fn run_gpu(
     ctx: &'static GpuContext,
     scene: &Scene,
     (validated, kernel_scene): (&scenes::Scene, &KernelScene),
+    traversal: TraversalChoice,
     options: &Options,
     stop: &'static AtomicBool,
     signal_error: &mut Option<PyErr>,
 ) -> anyhow::Result<Rendered> {
+    let traversal = traversal.resolve(ctx)?;
     let mut cache = scene.gpu.lock().unwrap_or_else(|e| e.into_inner());
     let reused = match cache.as_mut() {
-        Some(c) if (c.aovs || !options.aovs) && same_objects(&c.scene, validated) => {
+        Some(c)
+            if (c.aovs || !options.aovs)
+                && c.traversal == traversal
+                && same_objects(&c.scene, validated) =>
+        {
             // Fails where the kernel lacks a feature the new parameters turn on.
             c.renderer.set_params(kernel_scene.params).is_ok()
         }
@@ -241,9 +262,10 @@ fn run_gpu(
         // Dropped first: two renderers' buffers need not fit the device at once.
         *cache = None;
         *cache = Some(GpuCache {
-            renderer: GpuRenderer::new(ctx, kernel_scene)?,
+            renderer: GpuRenderer::with_traversal(ctx, kernel_scene, traversal)?,
             scene: validated.clone(),
             aovs: options.aovs,
+            traversal,
         });
     }
     let renderer = &mut cache.as_mut().expect("filled above").renderer;
@@ -254,6 +276,7 @@ fn run_gpu(
     }
     result.map(|r| Rendered {
         kernel_reused: reused,
+        traversal,
         ..r
     })
 }
@@ -262,7 +285,7 @@ fn run_gpu(
 /// the image and the other outputs as H×W×3 float32 NumPy arrays, and the statistics.
 #[pyfunction]
 #[pyo3(signature = (scene, *, spp=None, width=None, height=None, max_bounces=None, seed=None,
-    light_sampling=None, device="auto", variance=false, aovs=false, denoise=false,
+    light_sampling=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
     time_limit=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
@@ -275,6 +298,7 @@ pub fn render<'py>(
     seed: Option<i64>,
     light_sampling: Option<bool>,
     device: &str,
+    traversal: &str,
     variance: bool,
     aovs: bool,
     denoise: bool,
@@ -283,6 +307,7 @@ pub fn render<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     let wall = Instant::now();
     let device = Device::parse(device)?;
+    let traversal = parse_traversal(traversal)?;
     let overrides = RenderOverrides {
         spp: checked("spp", spp, 1, MAX_SPP as i64)?,
         width: checked("width", width, 1, MAX_IMAGE_SIDE as i64)?,
@@ -342,6 +367,7 @@ pub fn render<'py>(
                 ctx,
                 this,
                 (&validated, &kernel_scene),
+                traversal,
                 &options,
                 stop.0,
                 &mut signal_error,
@@ -388,6 +414,7 @@ pub fn render<'py>(
     stats.set_item("nonfinite_samples", rendered.nonfinite_samples)?;
     stats.set_item("device", rendered.device)?;
     stats.set_item("backend", rendered.backend)?;
+    stats.set_item("traversal", rendered.traversal.name())?;
     stats.set_item("kernel_reused", rendered.kernel_reused)?;
     stats.set_item("samples", (0u32, rendered.spp))?;
 

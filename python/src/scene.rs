@@ -5,6 +5,8 @@ use crate::render::GpuCache;
 use crate::SceneError;
 use glint::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use glint::scene;
+use glint::scene::model;
+use glint::scene::model_toml::model_toml;
 use pyo3::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -141,25 +143,46 @@ pub fn scene_error(e: scene::SceneError) -> PyErr {
     .unwrap_or_else(|e| e)
 }
 
-/// load(path) -> Scene
+/// load(path, camera=None) -> Scene
 ///
-/// Reads and validates a scene file (TOML) as `glint render` does. Raises glint.SceneError
-/// with the CLI's message (file, line and column, field) for a bad scene.
+/// Reads and validates a scene file (TOML) as `glint render` does, or builds the scene of a
+/// model file (.glb, .gltf, .obj, .ply) as `glint render model.glb` does: the file's camera
+/// (`camera`: `--camera N`) or a framing one, its lights, the studio environment. Raises
+/// glint.SceneError with the CLI's message (file, line and column, field) for a bad scene.
 #[pyfunction]
-pub fn load(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
+#[pyo3(signature = (path, camera = None))]
+pub fn load(py: Python<'_>, path: PathBuf, camera: Option<usize>) -> PyResult<Scene> {
+    let unreadable = |path: &Path, message: String| scene::SceneError {
+        path: path.to_owned(),
+        position: None,
+        field: None,
+        message,
+    };
     let (scene, text) = py
         .detach(|| {
+            if model::is_model_file(&path) {
+                let options = model::ModelOptions {
+                    camera,
+                    ..Default::default()
+                };
+                let built = model::load_model(&path, &options)?;
+                // The scene file `--print-scene` writes, which renders the same scene.
+                let text = model_toml(&built);
+                return Ok((built.scene, text));
+            }
+            if camera.is_some() {
+                return Err(unreadable(
+                    &path,
+                    "camera applies to a model file, not to a scene file: set [camera] in it"
+                        .into(),
+                ));
+            }
             let scene = scene::Scene::load(&path)?;
             // Read again for Scene.table: it passed, so it is UTF-8 text within the limit,
             // unless it changed in between.
             let text = read_regular_file(&path, SCENE_FILE_LIMIT, "scene file")
                 .and_then(|b| String::from_utf8(b).map_err(|e| e.to_string()))
-                .map_err(|message| scene::SceneError {
-                    path: path.clone(),
-                    position: None,
-                    field: None,
-                    message,
-                })?;
+                .map_err(|message| unreadable(&path, message))?;
             Ok((scene, text))
         })
         .map_err(scene_error)?;
