@@ -143,3 +143,21 @@ def test_denoise(cornell):
     assert result.image.shape == plain.shape and np.isfinite(result.image).all()
     assert not np.array_equal(result.image, plain)
     assert result.stats["denoise_seconds"] > 0
+
+
+def test_a_model_file_is_a_scene_as_on_the_command_line(cli, root, tmp_path):
+    """glint.load("model.gltf") builds the scene `glint render model.gltf` renders (the file's
+    camera, its lights, the studio environment): the same bytes on the CPU; its structure is
+    the scene file --print-scene writes, so it edits like any scene."""
+    model = root / "tests" / "models" / "lights-cameras.gltf"
+    settings = dict(width=16, height=12, spp=2, seed=1, max_bounces=3)
+    out = tmp_path / "model.exr"
+    cli("render", model, "--cpu", "--camera", 1, *cli_flags(settings), "-o", out)
+    scene = glint.load(model, camera=1)
+    image = glint.render(scene, device="cpu", **settings)
+    assert np.array_equal(image.view(np.uint32), glint.read(out).view(np.uint32))
+    assert glint.load(model) != scene  # camera 0
+    scene.camera.vfov = 20.0
+    assert not np.array_equal(glint.render(scene, device="cpu", **settings), image)
+    with pytest.raises(glint.SceneError, match="camera applies to a model file"):
+        glint.load(root / "scenes" / "cornell.toml", camera=1)

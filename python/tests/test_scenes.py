@@ -76,9 +76,11 @@ def test_a_toml_syntax_error_and_a_missing_file(cli, tmp_path):
     assert message.startswith(str(missing)) and message in stderr
 
 
-def test_dict_and_string_errors_name_the_field():
-    with pytest.raises(glint.SceneError, match=r"<string>:1:\d+: "):
-        glint.load_string("[camera]\neye = 1\n")
+def test_dict_and_string_errors_name_the_field(cornell):
+    text = cornell.read_text().replace("eye = [278.0, 278.0, -800.0]", "eye = 1")
+    line = text.splitlines().index("eye = 1") + 1
+    with pytest.raises(glint.SceneError, match=rf"^<string>:{line}:\d+: "):
+        glint.load_string(text)
     with pytest.raises(glint.SceneError, match=r"^<dict>"):
         glint.load_dict({"camera": {"eye": [0, 0, 0]}})
     with pytest.raises(ValueError, match=r"scene\.camera\.eye\[0\]: a NoneType"):
@@ -100,6 +102,7 @@ def test_dict_and_string_errors_name_the_field():
         (dict(max_bounces=5000), r"max_bounces: must be in 0\.\."),
         (dict(seed=2**32), r"seed: must be in 0\.\."),
         (dict(device="tpu"), r"device: expected"),
+        (dict(traversal="rt"), r"traversal: expected"),
         (dict(aovs=("colour",)), r"aovs: expected"),
         (dict(light_sampling="maybe"), r"light_sampling: expected"),
         (dict(time_limit=-1), r"time_limit: must be"),
