@@ -22,6 +22,9 @@ struct Hit {
     index: u32,
     // Texture coordinates (texture.wgsl); computed only when HAS_TEXTURES.
     uv: vec2<f32>,
+    // A triangle hit's barycentrics (of v0, v1, v2), for its vertex tangents (normal_map.wgsl);
+    // zero on other primitives.
+    barycentrics: vec3<f32>,
 }
 
 // Nearest t > 0 of a sphere hit, or NO_HIT. The discriminant is r^2 - |oc - h d|^2 rather than
@@ -182,6 +185,7 @@ fn intersect_scene(ray: Ray) -> Hit {
     } else if HAS_TRIANGLES && closest.primitive == PRIMITIVE_TRIANGLE {
         let tri = triangles[closest.index];
         let b = triangle_barycentrics(tri, triangle_ray(ray));
+        hit.barycentrics = b;
         outward = triangle_normal(tri);
         // On the triangle's plane: v0 + b1 e1 + b2 e2, from the edges the normal is made of.
         let surface = triangle_surface_point(tri, b);

@@ -135,14 +135,20 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
     if emitter_is_triangle(e.primitive) {
         // Uniform on the triangle's area.
         let tri = triangles[e.index];
-        let to_light = triangle_point(tri, u) - p;
+        let b = triangle_sample_barycentrics(u);
+        let to_light = triangle_point(tri, b) - p;
         let t = length(to_light);
         if t <= 0.0 {
             return out;
         }
         out.dir = to_light / t;
         out.pdf = e.probability * area_to_solid_angle(t, dot(triangle_normal(tri), out.dir), tri.area);
-        out.radiance = materials[tri.material].emission;
+        // The emission where the sample lies (glTF's emissive texture).
+        let m = materials[tri.material];
+        out.radiance = m.emission;
+        if HAS_TEXTURES && m.emission_texture != NO_TEXTURE {
+            out.radiance = emission_at(m, triangle_uv(e.index, b));
+        }
         return out;
     }
     if emitter_is_quad(e.primitive) {

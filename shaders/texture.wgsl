@@ -1,5 +1,6 @@
 // Textures (mirror: src/cpu/texture.rs): texture coordinates at a hit, image lookups with
-// bilinear filtering and repeat wrapping, procedural checkers, and the material at a hit.
+// bilinear or nearest filtering and repeat, clamped or mirrored wrapping, procedural checkers,
+// and the material at a hit.
 //
 // Textures live in storage buffers and are filtered by hand, not by a sampler: a hardware
 // sampler's filtering precision is implementation-defined (weights may be 8-bit fixed point),
@@ -58,19 +59,65 @@ fn wrapped_pair(position_floor: f32, size: u32) -> vec2<u32> {
     return vec2<u32>(first, second);
 }
 
-// Bilinear filtering with repeat wrapping; texel centres are at ((x + 0.5) / width,
+// Index i (-1 to 2 size) of a mirrored repeat: texels 0 ... size - 1, then size - 1 ... 0, and
+// so on.
+fn mirrored(i: i32, size: u32) -> u32 {
+    let period = 2 * i32(size);
+    let j = ((i % period) + period) % period;
+    return u32(select(period - 1 - j, j, j < i32(size)));
+}
+
+// The two texels to blend along one axis and the second one's weight (see axis_texels in
+// src/cpu/texture.rs).
+struct AxisTexels {
+    pair: vec2<u32>,
+    weight: f32,
+}
+
+// Along one axis of size texels, at texture coordinate coord with wrap mode: the two texels to
+// blend and the second one's weight (0 when nearest). Repeat wraps coord into [0, 1) first,
+// mirrored repeat into [0, 2), clamp clamps it to [0, 1].
+fn axis_texels(coord: f32, size: u32, mode: u32, nearest: bool) -> AxisTexels {
+    let half = select(0.5, 0.0, nearest);
+    if mode == TEXTURE_WRAP_MIRROR {
+        let position = (coord - 2.0 * floor(coord * 0.5)) * f32(size) - half;
+        let p = floor(position);
+        let weight = select(position - p, 0.0, nearest);
+        let i = i32(p);
+        return AxisTexels(vec2<u32>(mirrored(i, size), mirrored(i + 1, size)), weight);
+    }
+    if mode == TEXTURE_WRAP_CLAMP {
+        let position = clamp(coord, 0.0, 1.0) * f32(size) - half;
+        let p = floor(position);
+        let weight = select(position - p, 0.0, nearest);
+        let first = u32(min(max(p, 0.0), f32(size - 1u)));
+        let second = u32(min(max(p + 1.0, 0.0), f32(size - 1u)));
+        return AxisTexels(vec2<u32>(first, second), weight);
+    }
+    let position = (coord - floor(coord)) * f32(size) - half;
+    let p = floor(position);
+    let weight = select(position - p, 0.0, nearest);
+    return AxisTexels(wrapped_pair(p, size), weight);
+}
+
+// The texture coordinates a texture's lookup uses: its transform (the identity, exactly,
+// unless glTF's KHR_texture_transform set one) applied to uv.
+fn transformed_uv(t: Texture, uv: vec2<f32>) -> vec2<f32> {
+    let h = vec3<f32>(uv, 1.0);
+    return vec2<f32>(dot(t.transform_u, h), dot(t.transform_v, h));
+}
+
+// Bilinear (or, with TEXTURE_NEAREST, nearest) filtering with the texture's wrap modes (repeat
+// unless a glTF sampler says otherwise); texel centres are at ((x + 0.5) / width,
 // (y + 0.5) / height), where the lookup returns the texel itself.
 fn image_lookup(t: Texture, uv: vec2<f32>) -> vec3<f32> {
-    let x = (uv.x - floor(uv.x)) * f32(t.width) - 0.5;
-    let y = (uv.y - floor(uv.y)) * f32(t.height) - 0.5;
-    let x_floor = floor(x);
-    let y_floor = floor(y);
-    let fx = x - x_floor;
-    let fy = y - y_floor;
-    let xs = wrapped_pair(x_floor, t.width);
-    let ys = wrapped_pair(y_floor, t.height);
-    let bottom = texel(t, xs.x, ys.x) * (1.0 - fx) + texel(t, xs.y, ys.x) * fx;
-    let top = texel(t, xs.x, ys.y) * (1.0 - fx) + texel(t, xs.y, ys.y) * fx;
+    let nearest = (t.sampling & TEXTURE_NEAREST) != 0u;
+    let xs = axis_texels(uv.x, t.width, t.sampling & 0xffu, nearest);
+    let ys = axis_texels(uv.y, t.height, (t.sampling >> 8u) & 0xffu, nearest);
+    let fx = xs.weight;
+    let fy = ys.weight;
+    let bottom = texel(t, xs.pair.x, ys.pair.x) * (1.0 - fx) + texel(t, xs.pair.y, ys.pair.x) * fx;
+    let top = texel(t, xs.pair.x, ys.pair.y) * (1.0 - fx) + texel(t, xs.pair.y, ys.pair.y) * fx;
     return bottom * (1.0 - fy) + top * fy;
 }
 
@@ -85,21 +132,35 @@ fn texture_lookup(index: u32, uv: vec2<f32>) -> vec3<f32> {
     if t.kind == TEXTURE_CHECKER {
         return checker_lookup(t, uv);
     }
-    return image_lookup(t, uv);
+    return image_lookup(t, transformed_uv(t, uv));
 }
 
-// The material at a hit with texture coordinates uv: textured colour and roughness replace
-// the constant ones, before any BSDF or AOV reads them.
+// The material at a hit with texture coordinates uv: textures multiply the constants (glTF's
+// rule; a TOML texture's constant is 1), before any BSDF or AOV reads them. A roughness
+// texture holds the roughness in x and the metallic factor in y (1 where the image gives none,
+// src/scene/texture.rs).
 fn material_at(m: Material, uv: vec2<f32>) -> Material {
     var out = m;
     if HAS_TEXTURES {
         if m.color_texture != NO_TEXTURE {
-            out.albedo = texture_lookup(m.color_texture, uv);
+            out.albedo = m.albedo * texture_lookup(m.color_texture, uv);
         }
         if m.roughness_texture != NO_TEXTURE {
-            let roughness = texture_lookup(m.roughness_texture, uv).x;
-            out.alpha = roughness * roughness;
+            let t = texture_lookup(m.roughness_texture, uv);
+            // alpha = (roughness t.x)^2, roughness^2 being the constant's alpha.
+            out.alpha = m.alpha * (t.x * t.x);
+            out.metallic = m.metallic * t.y;
         }
+        out.emission = emission_at(m, uv);
     }
     return out;
+}
+
+// The radiance material m emits at texture coordinates uv: its emission times its emission
+// texture there (sRGB-decoded), if it has one. Light sampling calls it at the point it samples.
+fn emission_at(m: Material, uv: vec2<f32>) -> vec3<f32> {
+    if HAS_TEXTURES && m.emission_texture != NO_TEXTURE {
+        return m.emission * texture_lookup(m.emission_texture, uv);
+    }
+    return m.emission;
 }

@@ -42,7 +42,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let ray = (*path).ray;
     let bounce = (*path).bounce;
     let light_sampling = LIGHT_SAMPLING && params.light_sampling != 0u && emitter_count() > 0u;
-    let hit = intersect_scene(ray);
+    var hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {
         var escaped = params.background;
@@ -68,6 +68,9 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         return true;
     }
     let m = material_at(materials[hit.material], hit.uv);
+    if HAS_TEXTURES && m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
+        hit.shading_normal = normal_mapped(hit, m, -ray.dir);
+    }
     if aovs_on() {
         (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
     }

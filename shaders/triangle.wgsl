@@ -101,12 +101,18 @@ fn triangle_normal(tri: Triangle) -> vec3<f32> {
     return normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0));
 }
 
-// A point uniform on the triangle's area from two uniform numbers (the square-root warp).
-fn triangle_point(tri: Triangle, u: vec2<f32>) -> vec3<f32> {
+// The barycentrics (of v0, v1, v2) of a point uniform on a triangle's area, from two uniform
+// numbers (the square-root warp).
+fn triangle_sample_barycentrics(u: vec2<f32>) -> vec3<f32> {
     let su = sqrt(u.x);
     let b0 = 1.0 - su;
     let b1 = u.y * su;
-    return b0 * tri.v0 + b1 * tri.v1 + (1.0 - b0 - b1) * tri.v2;
+    return vec3<f32>(b0, b1, 1.0 - b0 - b1);
+}
+
+// The point of the triangle at barycentrics b.
+fn triangle_point(tri: Triangle, b: vec3<f32>) -> vec3<f32> {
+    return b.x * tri.v0 + b.y * tri.v1 + b.z * tri.v2;
 }
 
 // Distance along a unit direction from p to the triangle's plane (negative or NaN: none ahead).

@@ -90,15 +90,21 @@ struct Material {
     // GGX alpha (roughness squared) for metal.
     alpha: f32,
     ior: f32,
-    // Texture replacing albedo at the hit, or NO_TEXTURE (texture.wgsl).
+    // Texture multiplying albedo at the hit, or NO_TEXTURE (texture.wgsl).
     color_texture: u32,
-    // Texture whose first channel replaces the metal's roughness (alpha = r * r), or NO_TEXTURE.
+    // Texture whose x multiplies the roughness (alpha by x * x) and y metallic, or NO_TEXTURE.
     roughness_texture: u32,
     // PBR: the conductor's share.
     metallic: f32,
     // PBR: KHR_materials_specular's colour and factor for the dielectric layer.
     specular_color: vec3<f32>,
     specular: f32,
+    // Texture multiplying emission at the hit (glTF's emissiveTexture), or NO_TEXTURE.
+    emission_texture: u32,
+    // Tangent-space normal map (glTF's normalTexture), or NO_TEXTURE; its x and y are scaled by
+    // normal_scale (normal_map.wgsl).
+    normal_texture: u32,
+    normal_scale: f32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;
@@ -126,6 +132,14 @@ struct TriangleNormals {
     smooth_shading: u32,
     n1: vec3<f32>,
     n2: vec3<f32>,
+}
+
+// A triangle's vertex tangents for normal mapping: xyz the unit tangent along increasing u, w
+// the bitangent's sign (bitangent = w * cross(normal, tangent), along increasing v).
+struct TriangleTangents {
+    t0: vec4<f32>,
+    t1: vec4<f32>,
+    t2: vec4<f32>,
 }
 
 // A node of the flattened BVH (src/scene/bvh.rs). An inner node (count == 0) has its children at
@@ -156,6 +170,10 @@ struct Emitter {
 
 const TEXTURE_IMAGE: u32 = 0u;
 const TEXTURE_CHECKER: u32 = 1u;
+const TEXTURE_WRAP_REPEAT: u32 = 0u;
+const TEXTURE_WRAP_CLAMP: u32 = 1u;
+const TEXTURE_WRAP_MIRROR: u32 = 2u;
+const TEXTURE_NEAREST: u32 = 65536u;
 
 // An image whose texels are texels[first_texel ..][.. width * height], bottom row first, or a
 // checker of two colours with `scale` squares per unit of u and of v (texture.wgsl).
@@ -168,6 +186,13 @@ struct Texture {
     color0: vec3<f32>,
     scale: f32,
     color1: vec3<f32>,
+    // Image lookups: TEXTURE_WRAP_* for u in bits 0-7 and for v in bits 8-15, and
+    // TEXTURE_NEAREST for unfiltered lookups.
+    sampling: u32,
+    // The texture coordinates the lookup uses: (dot(transform_u, (u, v, 1)),
+    // dot(transform_v, (u, v, 1))) (glTF's KHR_texture_transform; the identity otherwise).
+    transform_u: vec3<f32>,
+    transform_v: vec3<f32>,
 }
 
 // A triangle's texture coordinates at its three vertices (zero where the mesh has none).

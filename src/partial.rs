@@ -78,6 +78,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         textures,
         texels,
         triangle_uvs,
+        triangle_tangents,
         environment_texels,
         environment_alias,
         lights,
@@ -103,6 +104,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     array("textures", bytemuck::cast_slice(textures));
     array("texels", bytemuck::cast_slice(texels));
     array("triangle uvs", bytemuck::cast_slice(triangle_uvs));
+    array("triangle tangents", bytemuck::cast_slice(triangle_tangents));
     array(
         "environment texels",
         bytemuck::cast_slice(environment_texels),

@@ -8,7 +8,7 @@ use crate::shader_types::{
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 25] = [
+pub const SHADER_PARTS: [(&str, &str); 26] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -39,6 +39,10 @@ pub const SHADER_PARTS: [(&str, &str); 25] = [
     ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
+    (
+        "normal_map.wgsl",
+        include_str!("../shaders/normal_map.wgsl"),
+    ),
     (
         "environment.wgsl",
         include_str!("../shaders/environment.wgsl"),

@@ -107,15 +107,22 @@ pub struct Material {
     /// GGX alpha (roughness squared) for metal.
     pub alpha: f32,
     pub ior: f32,
-    /// Index into the texture descriptors replacing `albedo` at the hit, or [`NO_TEXTURE`].
+    /// Index into the texture descriptors multiplying `albedo` at the hit, or [`NO_TEXTURE`].
     pub color_texture: u32,
-    /// Texture whose first channel replaces the metal's roughness (alpha = r²), or [`NO_TEXTURE`].
+    /// Texture whose x multiplies the roughness (alpha by x²) and y `metallic`, or [`NO_TEXTURE`].
     pub roughness_texture: u32,
     /// PBR: the conductor's share.
     pub metallic: f32,
     /// PBR: KHR_materials_specular's colour and factor for the dielectric layer.
     pub specular_color: [f32; 3],
     pub specular: f32,
+    /// Texture multiplying `emission` at the hit (glTF's emissiveTexture), or [`NO_TEXTURE`].
+    pub emission_texture: u32,
+    /// Tangent-space normal map (glTF's normalTexture), or [`NO_TEXTURE`]; its x and y are
+    /// scaled by `normal_scale` (`src/cpu/normal_map.rs`).
+    pub normal_texture: u32,
+    pub normal_scale: f32,
+    pub _pad: u32,
 }
 
 /// `Material::color_texture` and `roughness_texture` when the value is constant.
@@ -171,6 +178,17 @@ pub struct TriangleNormals {
     pub _pad2: u32,
 }
 
+/// A triangle's vertex tangents for normal mapping (glTF's TANGENT, or MikkTSpace's): xyz the
+/// unit tangent along increasing u, w the bitangent's sign (bitangent = w · normal × tangent,
+/// along increasing v, glint's v being up). One per triangle when a material has a normal map.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TriangleTangents {
+    pub t0: [f32; 4],
+    pub t1: [f32; 4],
+    pub t2: [f32; 4],
+}
+
 /// A node of the flattened BVH. An inner node (`count == 0`) has its children at `first` and
 /// `first + 1`; a leaf holds `bvh_primitives[first .. first + count]`.
 #[repr(C)]
@@ -193,7 +211,7 @@ pub const TEXTURE_CHECKER: u32 = 1;
 /// whose texels are `texels[first_texel ..][.. width * height]`, bottom row first, or a checker
 /// of two colours with `scale` squares per unit of u and of v.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Texture {
     /// `TEXTURE_IMAGE` or `TEXTURE_CHECKER`.
     pub kind: u32,
@@ -204,7 +222,40 @@ pub struct Texture {
     pub color0: [f32; 3],
     pub scale: f32,
     pub color1: [f32; 3],
-    pub _pad: u32,
+    /// Image lookups: `TEXTURE_WRAP_*` for u in bits 0–7 and for v in bits 8–15, and
+    /// [`TEXTURE_NEAREST`] for unfiltered lookups.
+    pub sampling: u32,
+    /// The texture coordinates the lookup uses: (u', v') = (transform_u · (u, v, 1),
+    /// transform_v · (u, v, 1)) (glTF's KHR_texture_transform; the identity otherwise).
+    pub transform_u: [f32; 3],
+    pub _pad0: u32,
+    pub transform_v: [f32; 3],
+    pub _pad1: u32,
+}
+
+/// [`Texture::sampling`]'s wrap modes (glTF's sampler modes) and its unfiltered flag.
+pub const TEXTURE_WRAP_REPEAT: u32 = 0;
+pub const TEXTURE_WRAP_CLAMP: u32 = 1;
+pub const TEXTURE_WRAP_MIRROR: u32 = 2;
+pub const TEXTURE_NEAREST: u32 = 1 << 16;
+
+impl Default for Texture {
+    fn default() -> Self {
+        Texture {
+            kind: TEXTURE_IMAGE,
+            first_texel: 0,
+            width: 0,
+            height: 0,
+            color0: [0.0; 3],
+            scale: 0.0,
+            color1: [0.0; 3],
+            sampling: 0,
+            transform_u: [1.0, 0.0, 0.0],
+            _pad0: 0,
+            transform_v: [0.0, 1.0, 0.0],
+            _pad1: 0,
+        }
+    }
 }
 
 /// A triangle's texture coordinates at its three vertices (zero where the mesh has none).

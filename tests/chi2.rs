@@ -303,6 +303,7 @@ emission = [1.0, 1.0, 1.0]
             normals: None,
             material: if k % 2 == 0 { bright } else { dim },
             uvs: None,
+            tangents: None,
         });
     }
     scene

@@ -53,6 +53,8 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             emitted_radiance: Vec3::ZERO,
             color_texture: None,
             roughness_texture: None,
+            emission_texture: None,
+            normal_texture: None,
         }],
         spheres: vec![],
         quads: vec![SceneQuad {

@@ -7,7 +7,7 @@ use glint::shader::{
 };
 use glint::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleNormals, TriangleUvs,
+    Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs,
 };
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
@@ -153,7 +153,10 @@ fn rust_structs_match_wgsl_layout() {
             roughness_texture,
             metallic,
             specular_color,
-            specular
+            specular,
+            emission_texture,
+            normal_texture,
+            normal_scale
         ]
     );
     assert_same_layout!(
@@ -204,10 +207,24 @@ fn rust_structs_match_wgsl_layout() {
         &module,
         Texture,
         "Texture",
-        [kind, first_texel, width, height, color0, scale, color1]
+        [
+            kind,
+            first_texel,
+            width,
+            height,
+            color0,
+            scale,
+            color1,
+            sampling,
+            transform_u,
+            transform_v
+        ]
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
-    assert_eq!(size_of::<Material>(), 64, "Material stays 64 bytes");
+    assert_same_layout!(&module, TriangleTangents, "TriangleTangents", [t0, t1, t2]);
+    // Five vec4s: glTF's emissive and normal textures took the fifth (a uniform-bound
+    // scene's materials stay far below the uniform limit).
+    assert_eq!(size_of::<Material>(), 80, "Material stays 80 bytes");
     assert_same_layout!(
         &module,
         EnvironmentTexel,

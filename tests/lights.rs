@@ -16,6 +16,18 @@ const ALBEDO: f64 = 0.5;
 /// one scattering event: a floor point's radiance is only what next-event estimation brings
 /// from the light, and the BSDF-sampled ray escapes into a black background.
 fn floor_scene(light: &str, size: u32, spp: u32) -> glint::scene::KernelScene {
+    floor_scene_under("", 20.0, light, size, spp)
+}
+
+/// [`floor_scene`] with `render_extra` (lines of `[render]`, such as a background) added and a
+/// floor reaching `half` from the origin along x and z.
+fn floor_scene_under(
+    render_extra: &str,
+    half: f32,
+    light: &str,
+    size: u32,
+    spp: u32,
+) -> glint::scene::KernelScene {
     kernel_scene(&format!(
         r#"
 [camera]
@@ -29,16 +41,18 @@ height = {size}
 spp = {spp}
 max_bounces = 1
 russian_roulette = false
+{render_extra}
 [materials.floor]
 type = "diffuse"
 color = [{ALBEDO}, {ALBEDO}, {ALBEDO}]
 [[quads]]
-corner = [-20.0, 0.0, -20.0]
-u = [40.0, 0.0, 0.0]
-v = [0.0, 0.0, 40.0]
+corner = [-{half:?}, 0.0, -{half:?}]
+u = [{width:?}, 0.0, 0.0]
+v = [0.0, 0.0, {width:?}]
 material = "floor"
 {light}
-"#
+"#,
+        width = 2.0 * half
     ))
 }
 
@@ -135,6 +149,83 @@ fn directional_light_on_a_floor_is_rho_e_cos_over_pi() {
             4,
             |_| ALBEDO * 3.0 * -direction.y / PI,
         );
+    }
+}
+
+/// The white furnace with every kind of light present: the floor under a uniform sky of radiance
+/// 1, lit also by a point light, a spot, a delta sun and a sun disk 2° across. The floor bounds
+/// a half-space, so only the sky and the lights reach it, each unoccluded: with one bounce a
+/// pixel is ρ (1 + Σ Eᵢ/π), Eᵢ the irradiance light i gives the point (the sky's is π; the
+/// disk's, wholly above the horizon, E cos θ exactly, its radiance being E/(π sin² half-angle)).
+/// Delta lights must take MIS weight 1 and the disk a weight shared with the BSDF rays that see
+/// it: either wrong moves pixels by several percent. The tolerance: five standard errors from
+/// each pixel's own sample variance (the pick of one light per sample is most of the noise),
+/// plus the closed form's spread over the pixel's footprint and 1e-4 relative for rounding.
+#[test]
+fn the_furnace_with_every_kind_of_light_is_rho_times_one_plus_irradiance_over_pi() {
+    let point = DVec3::new(-0.5, 2.0, 0.7);
+    let spot = DVec3::new(1.0, 2.5, -0.5);
+    let sun = DVec3::new(0.3, -1.0, 0.4).normalize();
+    let disk = DVec3::new(-0.2, -1.0, 0.1).normalize();
+    // A floor just wider than the view (±4.2 at the camera's 70°): the suns' power for the
+    // choice of light grows with the scene's bounding radius, and on the 40 × 40 floor they
+    // would leave the point light 2% of the picks, a heavy-tailed estimate the variance of
+    // 256 samples does not capture. The sky sees only the upper half-space either way.
+    let scene = floor_scene_under(
+        "background = [1.0, 1.0, 1.0]",
+        5.0,
+        "[[lights]]\ntype = \"point\"\nposition = [-0.5, 2.0, 0.7]\nintensity = 7.0\n\
+         [[lights]]\ntype = \"spot\"\nposition = [1.0, 2.5, -0.5]\ndirection = [0.0, -1.0, 0.0]\n\
+         intensity = 9.0\ninner_angle = 20.0\nouter_angle = 40.0\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [0.3, -1.0, 0.4]\nintensity = 0.8\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [-0.2, -1.0, 0.1]\nintensity = 0.6\n\
+         angle = 2.0\n",
+        16,
+        1024,
+    );
+    let irradiance = |x: DVec3| {
+        let to_point = point - x;
+        let d2 = to_point.length_squared();
+        let from_point = 7.0 * (to_point.y / d2.sqrt()) / d2;
+        let to_spot = spot - x;
+        let d2 = to_spot.length_squared();
+        let cos = to_spot.y / d2.sqrt();
+        let from_spot = 9.0 * gltf_spot_falloff(cos, 20.0, 40.0) * cos / d2;
+        from_point + from_spot + 0.8 * -sun.y + 0.6 * -disk.y
+    };
+    let radiance = |x: DVec3| ALBEDO * (1.0 + irradiance(x) / PI);
+    let params = &scene.params;
+    for (device, mut renderer) in common::renderers(&scene) {
+        let (image, variance) = common::render_with_variance(renderer.as_mut(), 1024);
+        let mut worst: f64 = 0.0;
+        for py in 0..image.height {
+            for px in 0..image.width {
+                let n = 8;
+                let values: Vec<f64> = (0..n * n)
+                    .map(|k| {
+                        let x = px as f64 + ((k % n) as f64 + 0.5) / n as f64;
+                        let y = py as f64 + ((k / n) as f64 + 0.5) / n as f64;
+                        radiance(floor_point(params, x, y))
+                    })
+                    .collect();
+                let mean = values.iter().sum::<f64>() / values.len() as f64;
+                let spread = values.iter().cloned().fold(f64::MIN, f64::max)
+                    - values.iter().cloned().fold(f64::MAX, f64::min);
+                let i = (py * image.width + px) as usize;
+                for c in 0..3 {
+                    let got = image.pixels[i][c] as f64;
+                    let standard_error = (variance.pixels[i][c] as f64).sqrt();
+                    let tolerance = 5.0 * standard_error + 2.0 * spread / 32.0 + 1e-4 * mean;
+                    let error = (got - mean).abs();
+                    assert!(
+                        error <= tolerance,
+                        "{device}: pixel ({px}, {py}) is {got}, expected {mean} ± {tolerance}"
+                    );
+                    worst = worst.max(error / tolerance);
+                }
+            }
+        }
+        eprintln!("{device} furnace with lights: worst error {worst:.2} of its tolerance");
     }
 }
 

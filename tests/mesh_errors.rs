@@ -564,12 +564,16 @@ fn required_extensions_glint_does_not_read() {
     );
 }
 
-/// Extensions merely used load, with one warning line naming them.
+/// Extensions merely used load, with one warning line naming those glint does not read fully
+/// (KHR_texture_transform it does).
 #[test]
 fn used_extensions_get_one_warning() {
     let (mut json, bin) = triangle_gltf();
-    json["extensionsUsed"] =
-        serde_json::json!(["KHR_texture_transform", "KHR_materials_clearcoat"]);
+    json["extensionsUsed"] = serde_json::json!([
+        "KHR_texture_transform",
+        "KHR_materials_sheen",
+        "KHR_materials_clearcoat"
+    ]);
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("t.gltf"),
@@ -587,7 +591,8 @@ fn used_extensions_get_one_warning() {
     assert_eq!(warnings.len(), 1, "{stderr}");
     assert!(
         warnings[0].contains("t.gltf: uses glTF extensions")
-            && warnings[0].contains("KHR_materials_clearcoat, KHR_texture_transform"),
+            && warnings[0].contains("KHR_materials_clearcoat, KHR_materials_sheen")
+            && !warnings[0].contains("KHR_texture_transform"),
         "{stderr}"
     );
 }

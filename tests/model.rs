@@ -488,3 +488,66 @@ fn model_flags_need_a_model_file() {
         assert!(lines[0].contains(flags[0]), "{lines:?}");
     }
 }
+
+#[test]
+fn the_studio_preset_and_bad_environment_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |environment: &str| {
+        let path = dir.path().join("s.toml");
+        std::fs::write(
+            &path,
+            format!(
+                "[camera]\neye = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+                 vfov = 40.0\n\n[render]\nwidth = 8\nheight = 8\nspp = 1\nmax_bounces = 1\n\n\
+                 [environment]\n{environment}\n"
+            ),
+        )
+        .unwrap();
+        Scene::load(&path).map_err(|e| e.to_string())
+    };
+    let scene = write("preset = \"studio\"\nstrength = 2.0").unwrap();
+    let studio = glint::scene::studio::environment(2.0, 0.0).unwrap();
+    assert_eq!(scene.environment, Some(studio));
+    for (text, needles) in [
+        ("preset = \"beach\"", &["environment.preset", "beach"][..]),
+        (
+            "preset = \"studio\"\nfile = \"x.hdr\"",
+            &["environment.preset", "not both"][..],
+        ),
+        ("strength = 1.0", &["environment.file", "missing"][..]),
+    ] {
+        let e = write(text).unwrap_err();
+        for needle in needles {
+            assert!(e.contains(needle), "{e} lacks {needle}");
+        }
+    }
+
+    let ply = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/models/bunny.ply");
+    for (flags, needles) in [
+        (
+            &["--camera", "0"][..],
+            &["bunny.ply", "--camera 0", "no cameras"][..],
+        ),
+        (
+            &["--environment-strength", "-1"][..],
+            &["--environment-strength"][..],
+        ),
+        (
+            &["--environment-rotate", "400"][..],
+            &["--environment-rotate"][..],
+        ),
+        (
+            &["--environment", "missing.hdr"][..],
+            &["bunny.ply", "--environment missing.hdr"][..],
+        ),
+    ] {
+        let mut args = vec!["render", ply.to_str().unwrap(), "--print-scene"];
+        args.extend_from_slice(flags);
+        let run = glint(&args);
+        let lines = stderr_lines(&run);
+        assert_eq!(run.status.code(), Some(2), "{flags:?} {lines:?}");
+        for needle in needles {
+            assert!(lines[0].contains(needle), "{lines:?} lacks {needle}");
+        }
+    }
+}

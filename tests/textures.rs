@@ -192,9 +192,13 @@ fn srgb_textures_are_linearised_and_data_textures_are_not() {
             "{device}"
         );
     }
+    // A roughness texture holds the roughness in x and the metallic factor, 1, in y.
     for (device, values) in lookups(&scene, m.roughness_texture, &[at]) {
         assert!(
-            (values[0] - Vec3::splat(128.0 / 255.0)).abs().max_element() < 1e-7,
+            (values[0] - Vec3::new(128.0 / 255.0, 1.0, 1.0))
+                .abs()
+                .max_element()
+                < 1e-7,
             "{device}"
         );
     }
@@ -632,4 +636,58 @@ fn gltf_texcoords_and_base_color_texture() {
         [uvs.uv0, uvs.uv1, uvs.uv2],
         [[0.0, 0.0], [1.0, 0.0], [1.0, 0.75]]
     );
+}
+
+/// The glTF sampler's wrap modes, nearest filtering and KHR_texture_transform's affine map, on
+/// a 4×2 data texture with distinct texels, at coordinates whose bilinear weights are exact
+/// binary fractions (so both devices return the texels, or their exact means, to 1e-6):
+/// - clamp on u: far outside [0, 1] reads the edge column, never the opposite one;
+/// - mirrored repeat on v: 1.25 reads row 1 (the mirror image of 0.75), −0.25 row 0, and
+///   v = 1 reads row 1 alone (repeat would blend it with row 0, the test above);
+/// - nearest: (0.49, 0.26) reads texel (1, 0) alone, where bilinear would blend four;
+/// - a transform that swaps u and v: (0.75, 0.375) reads what (0.375, 0.75) reads untransformed.
+#[test]
+fn wrap_modes_nearest_filtering_and_transforms() {
+    use glint::shader_types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
+    let dir = tempfile::tempdir().unwrap();
+    let (width, height) = (4u32, 2u32);
+    write_png(&dir.path().join("t.png"), width, height, distinct);
+    let material = "type = \"metal\"\ncolor = [1.0, 1.0, 1.0]\nroughness = { texture = \"t.png\" }";
+    let mut scene = scene_with(dir.path(), material, 4).unwrap().kernel_scene();
+    let texel = |x: u32, y: u32| Vec3::from_slice(&scene.texels[(y * width + x) as usize][..3]);
+    let base = scene.textures[0];
+    let mut variant = |sampling: u32, transform: Option<([f32; 3], [f32; 3])>| {
+        let mut t = base;
+        t.sampling = sampling;
+        if let Some((u, v)) = transform {
+            t.transform_u = u;
+            t.transform_v = v;
+        }
+        scene.textures.push(t);
+        scene.textures.len() as u32 - 1
+    };
+    let clamp_mirror = variant(TEXTURE_WRAP_CLAMP | (TEXTURE_WRAP_MIRROR << 8), None);
+    let nearest = variant(TEXTURE_NEAREST, None);
+    let swapped = variant(0, Some(([0.0, 1.0, 0.0], [1.0, 0.0, 0.0])));
+    let row_centre = 0.25;
+    let cases = [
+        (clamp_mirror, Vec2::new(-0.3, row_centre), texel(0, 0)),
+        (clamp_mirror, Vec2::new(1.7, row_centre), texel(3, 0)),
+        (clamp_mirror, Vec2::new(0.125, 1.25), texel(0, 1)),
+        (clamp_mirror, Vec2::new(0.125, -0.25), texel(0, 0)),
+        (clamp_mirror, Vec2::new(0.875, 1.0), texel(3, 1)),
+        (nearest, Vec2::new(0.49, 0.26), texel(1, 0)),
+        (nearest, Vec2::new(0.99, 0.99), texel(3, 1)),
+        (swapped, Vec2::new(0.75, 0.375), texel(1, 1)),
+        (0, Vec2::new(0.375, 0.75), texel(1, 1)),
+    ];
+    for (texture, uv, want) in cases {
+        for (device, values) in lookups(&scene, texture, &[uv]) {
+            assert!(
+                (values[0] - want).abs().max_element() <= 1e-6,
+                "{device}: texture {texture} at {uv}: {} against {want}",
+                values[0]
+            );
+        }
+    }
 }

@@ -817,3 +817,64 @@ fn the_viewer_memory_stops_growing() {
         "the viewer grew by {growth} bytes over 300 frames ({after_start} → {later})"
     );
 }
+
+#[test]
+fn a_model_file_is_viewed_and_its_edits_are_picked_up() {
+    if skip_gpu() {
+        return;
+    }
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("lc.gltf");
+    let original = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models/lights-cameras.gltf"),
+    )
+    .unwrap();
+    std::fs::write(&model, &original).unwrap();
+    let (child, rx) = spawn_with_log(view_command(
+        &x,
+        dir.path(),
+        &[
+            "lc.gltf",
+            "--camera",
+            "1",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--spp-per-frame",
+            "2",
+            "--frames",
+            "10",
+            "--script",
+            "3:wait-edit; 6:wait-edit",
+        ],
+    ));
+    let waiting = |v: &Value| v["event"] == "waiting-for-edit";
+    let mut log = wait_for(&rx, "first wait", waiting);
+    // A dimmer point light, then a negative intensity.
+    let bright = "\"intensity\": 6830";
+    assert!(original.contains(bright));
+    let dim = original.replace(bright, "\"intensity\": 683");
+    save_atomically(&model, &dim);
+    log.extend(wait_for(&rx, "second wait", waiting));
+    save_atomically(&model, &original.replace(bright, "\"intensity\": -1"));
+    log.extend(rx.iter());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{}: {stderr}", out.status);
+    let reloads = events(&log, "reload");
+    assert_eq!(reloads.len(), 2, "{log:?}");
+    assert_eq!(reloads[0]["ok"].as_bool(), Some(true), "{log:?}");
+    assert_eq!(reloads[1]["ok"].as_bool(), Some(false), "{log:?}");
+    let error = reloads[1]["error"].as_str().unwrap();
+    assert!(
+        error.contains("lc.gltf") && error.contains("lights[0].intensity"),
+        "{error}"
+    );
+    let spp: Vec<u64> = frames(&log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect();
+    assert_eq!(spp, [1, 3, 5, 1, 3, 5, 7, 9, 11, 13]);
+}

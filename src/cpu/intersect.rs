@@ -64,6 +64,9 @@ pub struct Hit {
     pub index: u32,
     /// Texture coordinates (`texture.rs`); computed only when `Geometry::textured`.
     pub uv: Vec2,
+    /// A triangle hit's barycentrics (of v0, v1, v2), for its vertex tangents
+    /// (`normal_map.rs`); zero on other primitives.
+    pub barycentrics: Vec3,
 }
 
 /// Nearest t > 0 of a sphere hit, or `NO_HIT`. The discriminant is r² − |oc − h d|² rather
@@ -221,11 +224,13 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
             primitive: 0,
             index: 0,
             uv: Vec2::ZERO,
+            barycentrics: Vec3::ZERO,
         };
     }
     // Zero: shade with the geometric normal.
     let mut shading = Vec3::ZERO;
     let mut uv = Vec2::ZERO;
+    let mut barycentrics = Vec3::ZERO;
     let (outward, surface, material) = if closest.primitive == PRIMITIVE_SPHERE {
         let s = &geometry.spheres[closest.index as usize];
         // Normalised, not divided by the radius: a normal a little too long would make
@@ -242,6 +247,7 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
     } else if closest.primitive == PRIMITIVE_TRIANGLE {
         let tri = &geometry.triangles[closest.index as usize];
         let b = triangle_barycentrics(tri, &triangle_ray(ray));
+        barycentrics = b;
         let n = &geometry.triangle_normals[closest.index as usize];
         if n.smooth_shading != 0 {
             shading = (b.x * Vec3::from(n.n0) + b.y * Vec3::from(n.n1) + b.z * Vec3::from(n.n2))
@@ -300,6 +306,7 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
         primitive: closest.primitive,
         index: closest.index,
         uv,
+        barycentrics,
     }
 }
 

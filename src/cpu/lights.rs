@@ -10,11 +10,14 @@ use super::frame::{basis, PI};
 use super::intersect::first_hit_is;
 use super::punctual::{punctual_visible, sample_punctual};
 use super::rng::Rng;
+use super::texture::{emission_at, triangle_uv};
 use super::trace::SceneRefs;
-use super::triangle::{triangle_normal, triangle_plane_distance, triangle_point};
+use super::triangle::{
+    triangle_normal, triangle_plane_distance, triangle_point, triangle_sample_barycentrics,
+};
 use super::Ray;
 use crate::shader_types::{
-    Sphere, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
+    Sphere, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -122,7 +125,8 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
     if e.primitive == PRIMITIVE_TRIANGLE {
         // Uniform on the triangle's area.
         let tri = &scene.triangles[e.index as usize];
-        let to_light = triangle_point(tri, u) - p;
+        let b = triangle_sample_barycentrics(u);
+        let to_light = triangle_point(tri, b) - p;
         let t = to_light.length();
         if t <= 0.0 {
             return out;
@@ -130,7 +134,14 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         out.dir = to_light / t;
         out.pdf =
             e.probability * area_to_solid_angle(t, triangle_normal(tri).dot(out.dir), tri.area);
-        out.radiance = Vec3::from(scene.materials[tri.material as usize].emission);
+        // The emission where the sample lies (glTF's emissive texture).
+        let m = &scene.materials[tri.material as usize];
+        out.radiance = if m.emission_texture != NO_TEXTURE {
+            let uv = triangle_uv(&scene.triangle_uvs[e.index as usize], b);
+            emission_at(&scene.textures(), m, uv)
+        } else {
+            Vec3::from(m.emission)
+        };
         return out;
     }
     if e.primitive == PRIMITIVE_QUAD {

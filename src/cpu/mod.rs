@@ -17,6 +17,7 @@ pub mod intersect;
 pub mod lights;
 pub mod material;
 pub mod microfacet;
+pub mod normal_map;
 pub mod pbr;
 pub mod punctual;
 pub mod renderer;

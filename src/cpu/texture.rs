@@ -1,9 +1,13 @@
 //! Textures (WGSL side: `shaders/texture.wgsl`): texture coordinates at a hit, image lookups
-//! with bilinear filtering and repeat wrapping, procedural checkers, and the material at a hit.
+//! with bilinear or nearest filtering and repeat, clamped or mirrored wrapping, procedural
+//! checkers, and the material at a hit.
 //! The filtering is written out by hand on both sides, in the same f32 operations, because a
 //! hardware sampler's filtering precision is implementation-defined.
 
-use crate::shader_types::{Material, Texture, TriangleUvs, NO_TEXTURE, TEXTURE_CHECKER};
+use crate::shader_types::{
+    Material, Texture, TriangleUvs, NO_TEXTURE, TEXTURE_CHECKER, TEXTURE_NEAREST,
+    TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR,
+};
 use glam::{UVec2, Vec2, Vec3};
 
 /// The same f32 as the WGSL literal.
@@ -82,17 +86,61 @@ fn wrapped_pair(position_floor: f32, size: u32) -> UVec2 {
     UVec2::new(first, second)
 }
 
-/// Bilinear filtering with repeat wrapping; texel centres are at ((x + 0.5)/width,
+/// Index `i` (−1 to 2·size) of a mirrored repeat: texels 0 … size−1, then size−1 … 0, and so
+/// on.
+fn mirrored(i: i32, size: u32) -> u32 {
+    let period = 2 * size as i32;
+    let j = ((i % period) + period) % period;
+    if j < size as i32 {
+        j as u32
+    } else {
+        (period - 1 - j) as u32
+    }
+}
+
+/// Along one axis of `size` texels, at texture coordinate `coord` with wrap `mode`: the two
+/// texels to blend and the second one's weight (0 when `nearest`). Repeat wraps `coord` into
+/// [0, 1) first, mirrored repeat into [0, 2), clamp clamps it to [0, 1].
+fn axis_texels(coord: f32, size: u32, mode: u32, nearest: bool) -> (UVec2, f32) {
+    let half = if nearest { 0.0 } else { 0.5 };
+    if mode == TEXTURE_WRAP_MIRROR {
+        let position = (coord - 2.0 * (coord * 0.5).floor()) * size as f32 - half;
+        let p = position.floor();
+        let weight = if nearest { 0.0 } else { position - p };
+        let i = p as i32;
+        return (UVec2::new(mirrored(i, size), mirrored(i + 1, size)), weight);
+    }
+    if mode == TEXTURE_WRAP_CLAMP {
+        let position = coord.clamp(0.0, 1.0) * size as f32 - half;
+        let p = position.floor();
+        let weight = if nearest { 0.0 } else { position - p };
+        let first = p.max(0.0).min((size - 1) as f32) as u32;
+        let second = (p + 1.0).max(0.0).min((size - 1) as f32) as u32;
+        return (UVec2::new(first, second), weight);
+    }
+    let position = (coord - coord.floor()) * size as f32 - half;
+    let p = position.floor();
+    let weight = if nearest { 0.0 } else { position - p };
+    (wrapped_pair(p, size), weight)
+}
+
+/// The texture coordinates a texture's lookup uses: its transform (the identity, exactly,
+/// unless glTF's KHR_texture_transform set one) applied to `uv`.
+pub fn transformed_uv(t: &Texture, uv: Vec2) -> Vec2 {
+    let h = Vec3::new(uv.x, uv.y, 1.0);
+    Vec2::new(
+        Vec3::from(t.transform_u).dot(h),
+        Vec3::from(t.transform_v).dot(h),
+    )
+}
+
+/// Bilinear (or, with `TEXTURE_NEAREST`, nearest) filtering with the texture's wrap modes
+/// (repeat unless a glTF sampler says otherwise); texel centres are at ((x + 0.5)/width,
 /// (y + 0.5)/height), where the lookup returns the texel itself.
 pub fn image_lookup(textures: &Textures, t: &Texture, uv: Vec2) -> Vec3 {
-    let x = (uv.x - uv.x.floor()) * t.width as f32 - 0.5;
-    let y = (uv.y - uv.y.floor()) * t.height as f32 - 0.5;
-    let x_floor = x.floor();
-    let y_floor = y.floor();
-    let fx = x - x_floor;
-    let fy = y - y_floor;
-    let xs = wrapped_pair(x_floor, t.width);
-    let ys = wrapped_pair(y_floor, t.height);
+    let nearest = t.sampling & TEXTURE_NEAREST != 0;
+    let (xs, fx) = axis_texels(uv.x, t.width, t.sampling & 0xff, nearest);
+    let (ys, fy) = axis_texels(uv.y, t.height, (t.sampling >> 8) & 0xff, nearest);
     let bottom = texel(textures, t, xs.x, ys.x) * (1.0 - fx) + texel(textures, t, xs.y, ys.x) * fx;
     let top = texel(textures, t, xs.x, ys.y) * (1.0 - fx) + texel(textures, t, xs.y, ys.y) * fx;
     bottom * (1.0 - fy) + top * fy
@@ -113,19 +161,34 @@ pub fn texture_lookup(textures: &Textures, index: u32, uv: Vec2) -> Vec3 {
     if t.kind == TEXTURE_CHECKER {
         return checker_lookup(t, uv);
     }
-    image_lookup(textures, t, uv)
+    image_lookup(textures, t, transformed_uv(t, uv))
 }
 
-/// The material at a hit with texture coordinates `uv`: textured colour and roughness replace
-/// the constant ones, before any BSDF or AOV reads them.
+/// The material at a hit with texture coordinates `uv`: textures multiply the constants
+/// (glTF's rule; a TOML texture's constant is 1), before any BSDF or AOV reads them. A
+/// roughness texture holds the roughness in x and the metallic factor in y (1 where the
+/// image gives none, `src/scene/texture.rs`).
 pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
     let mut out = *m;
     if m.color_texture != NO_TEXTURE {
-        out.albedo = texture_lookup(textures, m.color_texture, uv).into();
+        out.albedo = (Vec3::from(m.albedo) * texture_lookup(textures, m.color_texture, uv)).into();
     }
     if m.roughness_texture != NO_TEXTURE {
-        let roughness = texture_lookup(textures, m.roughness_texture, uv).x;
-        out.alpha = roughness * roughness;
+        let t = texture_lookup(textures, m.roughness_texture, uv);
+        // alpha = (roughness · t.x)², roughness² being the constant's alpha.
+        out.alpha = m.alpha * (t.x * t.x);
+        out.metallic = m.metallic * t.y;
     }
+    out.emission = emission_at(textures, m, uv).into();
     out
+}
+
+/// The radiance material `m` emits at texture coordinates `uv`: its emission times its
+/// emission texture there (sRGB-decoded), if it has one. Light sampling calls it at the point
+/// it samples.
+pub fn emission_at(textures: &Textures, m: &Material, uv: Vec2) -> Vec3 {
+    if m.emission_texture != NO_TEXTURE {
+        return Vec3::from(m.emission) * texture_lookup(textures, m.emission_texture, uv);
+    }
+    Vec3::from(m.emission)
 }

@@ -9,6 +9,7 @@ use super::environment::environment_radiance;
 use super::intersect::{crosses_shading_side, intersect_scene, Geometry, NO_HIT};
 use super::lights::{light_pdf, light_visible, nee_weight, power_heuristic, sample_light};
 use super::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
+use super::normal_map::normal_mapped;
 use super::punctual::sun_disks_radiance;
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::surface::offset_ray_origin;
@@ -17,7 +18,8 @@ use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
+    Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs, NO_TEXTURE,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -37,6 +39,8 @@ pub struct SceneRefs<'a> {
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
     pub triangle_uvs: &'a [TriangleUvs],
+    /// One per triangle when a material has a normal map, else empty.
+    pub triangle_tangents: &'a [TriangleTangents],
     /// Empty without an environment map.
     pub environment_texels: &'a [EnvironmentTexel],
     pub environment_alias: &'a [EnvironmentAlias],
@@ -62,6 +66,7 @@ impl<'a> SceneRefs<'a> {
             textures: &scene.textures,
             texels: &scene.texels,
             triangle_uvs: &scene.triangle_uvs,
+            triangle_tangents: &scene.triangle_tangents,
             lights: &scene.lights,
         }
     }
@@ -145,7 +150,7 @@ pub fn path_step(
     let ray = path.ray;
     let bounce = path.bounce;
     let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
-    let hit = intersect_scene(&scene.geometry(), &ray);
+    let mut hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
         // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
@@ -184,6 +189,15 @@ pub fn path_step(
         &scene.materials[hit.material as usize],
         hit.uv,
     );
+    if m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
+        hit.shading_normal = normal_mapped(
+            &scene.textures(),
+            &hit,
+            m,
+            &scene.triangle_tangents[hit.index as usize],
+            -ray.dir,
+        );
+    }
     if aovs_on(params) {
         aov_record_hit(&mut path.aov, bounce, &hit, m);
     }

@@ -128,12 +128,18 @@ pub fn triangle_normal(tri: &Triangle) -> Vec3 {
         .normalize()
 }
 
-/// A point uniform on the triangle's area from two uniform numbers (the square-root warp).
-pub fn triangle_point(tri: &Triangle, u: (f32, f32)) -> Vec3 {
+/// The barycentrics (of v0, v1, v2) of a point uniform on a triangle's area, from two uniform
+/// numbers (the square-root warp).
+pub fn triangle_sample_barycentrics(u: (f32, f32)) -> Vec3 {
     let su = u.0.sqrt();
     let b0 = 1.0 - su;
     let b1 = u.1 * su;
-    b0 * Vec3::from(tri.v0) + b1 * Vec3::from(tri.v1) + (1.0 - b0 - b1) * Vec3::from(tri.v2)
+    Vec3::new(b0, b1, 1.0 - b0 - b1)
+}
+
+/// The point of the triangle at barycentrics `b`.
+pub fn triangle_point(tri: &Triangle, b: Vec3) -> Vec3 {
+    b.x * Vec3::from(tri.v0) + b.y * Vec3::from(tri.v1) + b.z * Vec3::from(tri.v2)
 }
 
 /// Distance along a unit direction from p to the triangle's plane (negative or NaN: none ahead).

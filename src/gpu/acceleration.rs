@@ -51,7 +51,7 @@ pub fn widened_triangle(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [[f32; 3]; 3] 
     use glam::DVec3;
     let p = [a, b, c].map(|v| DVec3::from(v.map(f64::from)));
     let n = (p[1] - p[0]).cross(p[2] - p[0]);
-    if !n.is_finite() || n.length_squared() == 0.0 {
+    if !n.is_finite() || n.length_squared() <= 0.0 {
         return [a, b, c];
     }
     let size = p.iter().map(|v| v.abs().max_element()).fold(0.0, f64::max)

@@ -217,6 +217,11 @@ impl<'a> GpuRenderer<'a> {
                     read_only,
                 ),
                 BufferNeed::new(
+                    "triangle tangents",
+                    array_bytes(&scene.triangle_tangents),
+                    read_only,
+                ),
+                BufferNeed::new(
                     "environment map",
                     array_bytes(&scene.environment_texels),
                     read_only,
@@ -262,6 +267,7 @@ impl<'a> GpuRenderer<'a> {
         let textures = storage_buffer(ctx, "textures", &scene.textures);
         let texels = storage_buffer(ctx, "texture texels", &scene.texels);
         let triangle_uvs = storage_buffer(ctx, "triangle texture coordinates", &scene.triangle_uvs);
+        let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
@@ -348,6 +354,7 @@ impl<'a> GpuRenderer<'a> {
                 (20, read_only, &textures),
                 (21, read_only, &texels),
                 (22, read_only, &triangle_uvs),
+                (28, read_only, &triangle_tangents),
                 (18, read_only, &environment_texels),
                 (19, read_only, &environment_alias),
                 (24, read_only, &lights),

@@ -92,7 +92,13 @@ fn is_float_format(format: image::ImageFormat) -> bool {
 /// …", "the image is 0×0", "the image has 2²⁶ texels; the limit is …".
 pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage, String> {
     let bytes = read_regular_file(path, IMAGE_FILE_LIMIT, "image file")?;
-    let reader = image::ImageReader::new(Cursor::new(&bytes))
+    decode_linear_image(&bytes, encoding)
+}
+
+/// Decodes an image file's bytes (read by [`load_linear_image`], or embedded in a glTF file)
+/// with the same checks; the error is a sentence, as there.
+pub fn decode_linear_image(bytes: &[u8], encoding: Encoding) -> Result<LinearImage, String> {
+    let reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| format!("cannot read the image: {e}"))?;
     let Some(format) = reader.format() else {
@@ -111,7 +117,7 @@ pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage,
     }
     let (width, height) = reader
         .into_dimensions()
-        .map_err(|e| decode_error(e, &bytes, format))?;
+        .map_err(|e| decode_error(e, bytes, format))?;
     if width == 0 || height == 0 {
         return Err(format!(
             "the image is {width}×{height}; it must have texels"
@@ -125,11 +131,11 @@ pub fn load_linear_image(path: &Path, encoding: Encoding) -> Result<LinearImage,
             format_size(MAX_IMAGE_TEXELS * 12)
         ));
     }
-    let mut reader = image::ImageReader::new(Cursor::new(&bytes));
+    let mut reader = image::ImageReader::new(Cursor::new(bytes));
     reader.set_format(format);
     let decoded = reader
         .decode()
-        .map_err(|e| decode_error(e, &bytes, format))?;
+        .map_err(|e| decode_error(e, bytes, format))?;
     let rgb = decoded.to_rgb32f();
     // to_rgb32f maps integer texels to [0, 1] linearly; the transfer function is ours to apply.
     let decode_srgb = encoding == Encoding::Srgb && !is_float_format(format);

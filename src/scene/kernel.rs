@@ -2,17 +2,18 @@
 //! that light sampling draws from.
 
 use super::bvh;
+use super::emitter_power::EmissionMeans;
 use super::environment;
 use super::light::LightKind;
 use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR,
-    MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    TriangleTangents, TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL,
+    MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT,
+    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
 #[derive(Clone, Debug)]
@@ -35,6 +36,8 @@ pub struct KernelScene {
     pub texels: Vec<[f32; 4]>,
     /// One per triangle when the scene has textures, else empty.
     pub triangle_uvs: Vec<TriangleUvs>,
+    /// One per triangle when a material has a normal map, else empty.
+    pub triangle_tangents: Vec<TriangleTangents>,
     /// The environment map's texels and alias table (`environment.rs`); empty without one.
     pub environment_texels: Vec<EnvironmentTexel>,
     pub environment_alias: Vec<EnvironmentAlias>,
@@ -60,6 +63,7 @@ impl KernelScene {
             + bytes(&self.textures)
             + bytes(&self.texels)
             + bytes(&self.triangle_uvs)
+            + bytes(&self.triangle_tangents)
             + bytes(&self.environment_texels)
             + bytes(&self.environment_alias)
             + bytes(&self.lights)
@@ -127,6 +131,8 @@ impl Scene {
                 emitted_radiance: radiance,
                 color_texture: None,
                 roughness_texture: None,
+                emission_texture: None,
+                normal_texture: None,
             });
         }
         scene
@@ -247,6 +253,10 @@ impl Scene {
                     metallic,
                     specular_color: specular_color.into(),
                     specular,
+                    emission_texture: m.emission_texture.unwrap_or(NO_TEXTURE),
+                    normal_texture: m.normal_texture.map_or(NO_TEXTURE, |(t, _)| t),
+                    normal_scale: m.normal_texture.map_or(1.0, |(_, s)| s),
+                    _pad: 0,
                 }
             })
             .collect();
@@ -304,6 +314,17 @@ impl Scene {
                     })
                     .collect()
             },
+            triangle_tangents: if self.materials.iter().any(|m| m.normal_texture.is_some()) {
+                self.triangles
+                    .iter()
+                    .map(|t| {
+                        let [t0, t1, t2] = t.tangents.unwrap_or_default().map(|t| t.into());
+                        TriangleTangents { t0, t1, t2 }
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
             environment_texels: Vec::new(),
             environment_alias: Vec::new(),
             lights: self
@@ -359,11 +380,19 @@ impl Scene {
                 powers.push((PRIMITIVE_QUAD, i as u32, power));
             }
         }
+        let mut textured = EmissionMeans::new(&self.textures);
         for (i, t) in self.triangles.iter().enumerate() {
             let [a, b, c] = t.vertices;
-            let power = radiance(t.material).element_sum() as f64 / 3.0
-                * 0.5
-                * (b - a).cross(c - a).length() as f64;
+            let m = &self.materials[t.material as usize];
+            let mean = match m.emission_texture {
+                Some(texture) if m.emitted_radiance != Vec3::ZERO => textured.triangle_mean(
+                    m.emitted_radiance,
+                    texture,
+                    t.uvs.unwrap_or([Vec2::ZERO; 3]),
+                ),
+                _ => radiance(t.material).element_sum() as f64 / 3.0,
+            };
+            let power = mean * 0.5 * (b - a).cross(c - a).length() as f64;
             if power > 0.0 {
                 powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }

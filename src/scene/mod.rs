@@ -8,6 +8,7 @@
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
 pub mod bvh;
+mod emitter_power;
 pub mod environment;
 mod file;
 pub mod image;
@@ -26,7 +27,7 @@ pub use kernel::{place_camera, KernelScene};
 
 use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -96,6 +97,8 @@ pub struct Triangle {
     pub material: u32,
     /// Texture coordinates at the vertices (v up), where the file gives them.
     pub uvs: Option<[Vec2; 3]>,
+    /// Vertex tangents (xyz unit, w the bitangent's sign) where the material has a normal map.
+    pub tangents: Option<[Vec4; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -178,10 +181,18 @@ pub struct Material {
     pub color: Vec3,
     /// `emission * strength`.
     pub emitted_radiance: Vec3,
-    /// Index into [`Scene::textures`] replacing `color` at each hit.
+    /// Index into [`Scene::textures`] multiplying `color` at each hit (1 for TOML textures).
     pub color_texture: Option<u32>,
-    /// Index into [`Scene::textures`] whose first channel replaces a metal's roughness.
+    /// Index into [`Scene::textures`] whose first channel multiplies the roughness (1 for TOML
+    /// textures) and whose second multiplies a pbr material's `metallic`.
     pub roughness_texture: Option<u32>,
+    /// Index into [`Scene::textures`] multiplying `emitted_radiance` at each point (glTF's
+    /// emissiveTexture; light sampling weighs each triangle by the texture's mean over it,
+    /// `src/scene/emitter_power.rs`).
+    pub emission_texture: Option<u32>,
+    /// Index into [`Scene::textures`] of a tangent-space normal map (glTF's normalTexture),
+    /// and the scale of its x and y.
+    pub normal_texture: Option<(u32, f32)>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

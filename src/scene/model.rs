@@ -245,6 +245,8 @@ fn default_material_value() -> Material {
         emitted_radiance: Vec3::ZERO,
         color_texture: None,
         roughness_texture: None,
+        emission_texture: None,
+        normal_texture: None,
     }
 }
 

@@ -3,8 +3,10 @@
 //! descriptor per texture and every image's texels in one array, bottom row first, so texture
 //! coordinates (v up) index rows directly.
 
-use super::image::{load_linear_image, Encoding};
-use crate::shader_types::{Texture, TEXTURE_CHECKER, TEXTURE_IMAGE};
+use super::image::{decode_linear_image, load_linear_image, Encoding, LinearImage};
+use crate::shader_types::{
+    Texture, TEXTURE_CHECKER, TEXTURE_IMAGE, TEXTURE_NEAREST, TEXTURE_WRAP_REPEAT,
+};
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -12,13 +14,39 @@ use std::path::{Path, PathBuf};
 /// Most texels of all textures together: the descriptors index them with a u32.
 pub const MAX_TOTAL_TEXELS: u64 = u32::MAX as u64;
 
+/// How a glTF texture reference reads its image: its sampler's wrap modes (`TEXTURE_WRAP_*`,
+/// for u and v) and filter, and KHR_texture_transform's affine map of (u, v, 1), in glint's
+/// texture coordinates (v up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampling {
+    pub wrap: [u32; 2],
+    pub nearest: bool,
+    pub transform: [[f32; 3]; 2],
+}
+
+impl Default for Sampling {
+    /// Repeat, bilinear, untransformed: what TOML textures use.
+    fn default() -> Self {
+        Sampling {
+            wrap: [TEXTURE_WRAP_REPEAT; 2],
+            nearest: false,
+            transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        }
+    }
+}
+
 /// What a texture is read for, which decides its decoding and the range its texels must lie in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum TextureUse {
     /// A reflectance: sRGB-decoded (PNG, JPEG), every channel in [0, 1].
     Color,
-    /// Metal roughness: linear (not sRGB-decoded), the first channel in [0, 1].
+    /// Roughness (metal, pbr): linear (not sRGB-decoded), the first channel in [0, 1].
     Roughness,
+    /// glTF's metallicRoughnessTexture: linear, roughness in green and metallic in blue, both
+    /// in [0, 1].
+    MetallicRoughness,
+    /// A tangent-space normal map (glTF's normalTexture): linear, every channel in [0, 1].
+    Normal,
 }
 
 /// Every texture of a scene, as the kernel reads them.
@@ -49,24 +77,59 @@ impl TextureSet {
         if let Some(&index) = self.loaded.get(&key) {
             return Ok(index);
         }
-        let encoding = match usage {
-            TextureUse::Color => Encoding::Srgb,
-            TextureUse::Roughness => Encoding::Linear,
-        };
-        let image = load_linear_image(path, encoding)?;
+        let image = load_linear_image(path, encoding(usage))?;
+        self.add(key, &path.display().to_string(), image, usage)
+    }
+
+    /// The texture of an image file's bytes embedded in `file` as `element` (a glTF file's
+    /// `images[2]`), decoded and checked like an image file the first time it is asked for.
+    pub fn embedded_image(
+        &mut self,
+        file: &Path,
+        element: &str,
+        bytes: &[u8],
+        usage: TextureUse,
+    ) -> Result<u32, String> {
+        let file = file.canonicalize().unwrap_or_else(|_| file.to_owned());
+        let shown = format!("{}: {element}", file.display());
+        // A key no file path has: the file's path with the element after a '#'.
+        let key = (
+            PathBuf::from(format!("{}#{element}", file.display())),
+            usage,
+        );
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        let image = decode_linear_image(bytes, encoding(usage))?;
+        self.add(key, &shown, image, usage)
+    }
+
+    /// Checks a decoded image's texels for `usage` and appends it; `shown` names it in warnings.
+    fn add(
+        &mut self,
+        key: (PathBuf, TextureUse),
+        shown: &str,
+        image: LinearImage,
+        usage: TextureUse,
+    ) -> Result<u32, String> {
         if let Some(clamped) = image.clamped {
             self.warnings
-                .push(format!("{}: {}", path.display(), clamped.warning()));
+                .push(format!("{shown}: {}", clamped.warning()));
         }
+        // The channels the use reads.
         let channels = match usage {
-            TextureUse::Color => 3,
-            TextureUse::Roughness => 1,
+            TextureUse::Color | TextureUse::Normal => 0..3,
+            TextureUse::Roughness => 0..1,
+            TextureUse::MetallicRoughness => 1..3,
         };
         // Rows from the top (as files store them) to rows from the bottom.
         for y in 0..image.height {
             for x in 0..image.width {
                 let texel = image.texel(x, image.height - 1 - y);
-                if let Some(&bad) = texel[..channels].iter().find(|c| !(0.0..=1.0).contains(*c)) {
+                if let Some(&bad) = texel[channels.clone()]
+                    .iter()
+                    .find(|c| !(0.0..=1.0).contains(*c))
+                {
                     return Err(format!(
                         "texel ({x}, {}) (from the top left) is {bad}; a {} texture's values must \
                          be in [0, 1]",
@@ -74,6 +137,8 @@ impl TextureSet {
                         match usage {
                             TextureUse::Color => "color",
                             TextureUse::Roughness => "roughness",
+                            TextureUse::MetallicRoughness => "metallic-roughness",
+                            TextureUse::Normal => "normal",
                         }
                     ));
                 }
@@ -90,7 +155,13 @@ impl TextureSet {
         for y in (0..image.height).rev() {
             for x in 0..image.width {
                 let [r, g, b] = image.texel(x, y);
-                self.texels.push([r, g, b, 0.0]);
+                // Roughness textures as the kernel reads them: x the roughness, y the
+                // metallic factor (1 where the texture gives none).
+                self.texels.push(match usage {
+                    TextureUse::Color | TextureUse::Normal => [r, g, b, 0.0],
+                    TextureUse::Roughness => [r, 1.0, 1.0, 0.0],
+                    TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
+                });
             }
         }
         let index = self.push(Texture {
@@ -116,8 +187,32 @@ impl TextureSet {
         })
     }
 
+    /// Texture `base` (an image) looked up with `sampling`: a descriptor of its own sharing the
+    /// image's texels, or `base` itself when the sampling is the default.
+    pub fn sampled(&mut self, base: u32, sampling: &Sampling) -> u32 {
+        if *sampling == Sampling::default() {
+            return base;
+        }
+        let mut texture = self.descriptors[base as usize];
+        texture.sampling = sampling.wrap[0]
+            | (sampling.wrap[1] << 8)
+            | if sampling.nearest { TEXTURE_NEAREST } else { 0 };
+        texture.transform_u = sampling.transform[0];
+        texture.transform_v = sampling.transform[1];
+        self.push(texture)
+    }
+
     fn push(&mut self, texture: Texture) -> u32 {
         self.descriptors.push(texture);
         self.descriptors.len() as u32 - 1
+    }
+}
+
+fn encoding(usage: TextureUse) -> Encoding {
+    match usage {
+        TextureUse::Color => Encoding::Srgb,
+        TextureUse::Roughness | TextureUse::MetallicRoughness | TextureUse::Normal => {
+            Encoding::Linear
+        }
     }
 }

@@ -126,6 +126,7 @@ fn run_probe_with(
     let textures = storage_buffer(ctx, "textures", &scene.textures);
     let texels = storage_buffer(ctx, "texels", &scene.texels);
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
+    let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let lights = storage_buffer(ctx, "lights", &scene.lights);
@@ -169,6 +170,7 @@ fn run_probe_with(
             (20, read_only, &textures),
             (21, read_only, &texels),
             (22, read_only, &triangle_uvs),
+            (28, read_only, &triangle_tangents),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
             (24, read_only, &lights),

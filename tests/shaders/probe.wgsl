@@ -116,6 +116,18 @@ fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
     probe_out[id.x] = vec4<f32>(texture_lookup(probe.seed, uv), 0.0);
 }
 
+// The material at a hit: material probe.seed of the bound scene at the texture coordinates of
+// triangle_uvs[id / 2].uv0 (tests/gltf_materials.rs fills them); even entries write albedo
+// and alpha, odd ones metallic.
+@compute @workgroup_size(256, 1, 1)
+fn probe_material_at(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    let m = material_at(materials[probe.seed], triangle_uv(id.x / 2u, vec3<f32>(1.0, 0.0, 0.0)));
+    probe_out[id.x] = select(vec4<f32>(m.metallic, 0.0, 0.0, 0.0), vec4<f32>(m.albedo, m.alpha), id.x % 2u == 0u);
+}
+
 // The emitter choice alone (pick_emitter, from the draws sample_light makes first): the
 // chosen primitive, its index and the probability reported for it.
 @compute @workgroup_size(256, 1, 1)
@@ -181,4 +193,26 @@ fn probe_closest_hit(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     probe_out[2u * id.x] = vec4<f32>(found.t, bitcast<f32>(found.primitive), bitcast<f32>(found.index), f32(flags));
     probe_out[2u * id.x + 1u] = vec4<f32>(expected.t, bitcast<f32>(expected.primitive), bitcast<f32>(expected.index), 0.0);
+}
+
+// Normal maps (tests/normal_maps.rs): rays from probe.position to a 16 x 16 grid of points
+// (x, y, 0) with x, y = -0.45 + 0.9 (i + 0.5) / 16, each hit's shading normal after its
+// material's normal map (as path_step applies it), and t.
+@compute @workgroup_size(256, 1, 1)
+fn probe_normal_map(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    let aim = vec3<f32>(-0.45 + 0.9 * (f32(id.x % 16u) + 0.5) / 16.0, -0.45 + 0.9 * (f32(id.x / 16u) + 0.5) / 16.0, 0.0);
+    let ray = Ray(probe.position, normalize(aim - probe.position));
+    var hit = intersect_scene(ray);
+    if hit.t == NO_HIT {
+        probe_out[id.x] = vec4<f32>(0.0, 0.0, 0.0, -1.0);
+        return;
+    }
+    let m = material_at(materials[hit.material], hit.uv);
+    if m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
+        hit.shading_normal = normal_mapped(hit, m, -ray.dir);
+    }
+    probe_out[id.x] = vec4<f32>(hit.shading_normal, hit.t);
 }

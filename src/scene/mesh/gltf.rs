@@ -14,16 +14,19 @@
 
 use super::gltf_nodes::placed_nodes;
 use super::{
-    check_emission, check_ior, check_reflectance, one_line, read_mesh_bytes, Geometry, MeshFile,
-    MeshPart, MAX_TRIANGLES,
+    check_emission, check_ior, check_reflectance, one_line, read_mesh_bytes, FileTextures,
+    Geometry, ImageSource, MeshFile, MeshPart, MAX_TRIANGLES,
 };
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
+use crate::scene::texture::Sampling;
 use crate::scene::{Material, MaterialKind};
+use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use base64::Engine as _;
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use gltf::json;
 use json::accessor::{ComponentType, Type};
 use json::mesh::{Mode, Semantic};
+use json::texture::{MagFilter, WrappingMode};
 use json::validation::Checked;
 use std::collections::hash_map::{Entry, HashMap};
 use std::path::{Path, PathBuf};
@@ -33,12 +36,19 @@ use std::rc::Rc;
 const REQUIRABLE_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
 ];
 
 /// Extensions glint reads entirely; any other the file uses gets a warning.
-const FULLY_READ_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_mesh_quantization"];
+const FULLY_READ_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+];
 
 /// Decoded vertex data may reach this many bytes per byte of the file's buffers (plus
 /// [`DECODE_SLACK`]): a byte index becomes a u32, a byte normal component an f32. It bounds
@@ -77,12 +87,31 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     let instances = instances(&root)?;
 
     let mut materials = Vec::new();
-    let mut color_textures = Vec::new();
+    let mut textures = Vec::new();
     let mut has_other_textures = false;
+    // Each image read once, however many materials use it.
+    let mut images: Vec<Option<Rc<ImageSource>>> = vec![None; root.images.len()];
     for (i, m) in root.materials.iter().enumerate() {
-        let (material, color_texture, other_textures) = material(&root, m, i, dir)?;
+        let (material, maps, other_textures) = material(&root, m, i, &mut warnings)?;
+        let mut source = |image: Option<(usize, Sampling)>| -> Result<_, String> {
+            let Some((i, sampling)) = image else {
+                return Ok(None);
+            };
+            if images[i].is_none() {
+                images[i] = Some(Rc::new(image_source(&root, &buffers, i, dir)?));
+            }
+            Ok(images[i].clone().map(|image| (image, sampling)))
+        };
+        textures.push(FileTextures {
+            color: source(maps.color)?,
+            metallic_roughness: source(maps.metallic_roughness)?,
+            emission: source(maps.emission)?,
+            normal: match maps.normal {
+                Some((image, scale)) => source(Some(image))?.map(|s| (s, scale)),
+                None => None,
+            },
+        });
         materials.push(material);
-        color_textures.push(color_texture);
         has_other_textures |= other_textures;
     }
 
@@ -134,7 +163,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     Ok(MeshFile {
         parts,
         materials,
-        color_textures,
+        textures,
         has_other_textures,
         warnings,
     })
@@ -362,36 +391,65 @@ fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
 }
 
 /// A glTF material as glint's, its colour texture's file, and whether it has other textures:
-/// `pbrMetallicRoughness`: baseColorFactor; metallicFactor ≥ 0.5 → metal with
-/// roughnessFactor, else diffuse; KHR_materials_transmission > 0.5 → dielectric with
-/// KHR_materials_ior (default 1.5); emissiveFactor × KHR_materials_emissive_strength → emission.
+/// `pbrMetallicRoughness` (baseColorFactor, metallicFactor, roughnessFactor, with glTF's
+/// defaults), KHR_materials_ior and KHR_materials_specular's factors → `pbr`;
+/// KHR_materials_transmission > 0 → dielectric with the ior (glint has no rough or partly
+/// transmissive dielectric yet: a warning says so); emissiveFactor ×
+/// KHR_materials_emissive_strength → emission. Warning lines go to `warnings`.
 fn material(
     root: &json::Root,
     m: &json::Material,
     index: usize,
-    dir: &Path,
-) -> Result<(Material, Option<PathBuf>, bool), String> {
+    warnings: &mut Vec<String>,
+) -> Result<(Material, MaterialImages, bool), String> {
     let name = format!("material{index}");
     let extensions = m.extensions.as_ref();
     let pbr = &m.pbr_metallic_roughness;
     let transmission = extensions
         .and_then(|e| e.transmission.as_ref())
         .map(|t| t.transmission_factor.0);
-    let kind = if transmission.is_some_and(|t| t > 0.5) {
-        let ior = extensions
-            .and_then(|e| e.ior.as_ref())
-            .map(|i| i.ior.0)
-            .filter(|&n| n > 0.0)
-            .unwrap_or(1.5);
-        MaterialKind::Dielectric {
-            ior: check_ior(&name, "KHR_materials_ior", ior)?,
-        }
-    } else if pbr.metallic_factor.0 >= 0.5 {
-        MaterialKind::Metal {
-            roughness: pbr.roughness_factor.0.clamp(0.0, 1.0),
-        }
+    // glTF's ior 0 is a special case glint cannot render; its default is 1.5.
+    let ior = extensions
+        .and_then(|e| e.ior.as_ref())
+        .map(|i| i.ior.0)
+        .filter(|&n| n > 0.0)
+        .unwrap_or(1.5);
+    let ior = check_ior(&name, "KHR_materials_ior", ior)?;
+    let kind = if let Some(t) = transmission.filter(|&t| t > 0.0) {
+        warnings.push(format!(
+            "materials[{index}]: KHR_materials_transmission {t} is rendered as a smooth, fully \
+             transmissive dielectric (ior {ior}); glint has no rough or partly transmissive one \
+             yet"
+        ));
+        MaterialKind::Dielectric { ior }
     } else {
-        MaterialKind::Diffuse
+        let unit = |what: &str, v: f32| {
+            if (0.0..=1.0).contains(&v) {
+                Ok(v)
+            } else {
+                Err(format!(
+                    "material {name:?}: {what} must be in [0, 1], got {v}"
+                ))
+            }
+        };
+        let specular = extensions.and_then(|e| e.specular.as_ref());
+        let specular_color = Vec3::from(specular.map_or([1.0; 3], |s| s.specular_color_factor.0));
+        if !specular_color.is_finite() || specular_color.min_element() < 0.0 {
+            return Err(format!(
+                "material {name:?}: KHR_materials_specular specularColorFactor must be ≥ 0, got \
+                 {specular_color}"
+            ));
+        }
+        MaterialKind::Pbr {
+            roughness: unit("roughnessFactor", pbr.roughness_factor.0)?,
+            metallic: unit("metallicFactor", pbr.metallic_factor.0)?,
+            ior,
+            specular: unit(
+                "KHR_materials_specular specularFactor",
+                specular.map_or(1.0, |s| s.specular_factor.0),
+            )?,
+            specular_color,
+        }
     };
     let color = check_reflectance(
         &name,
@@ -411,25 +469,121 @@ fn material(
         "emissiveFactor × emissive strength",
         Vec3::from(m.emissive_factor.0) * strength,
     )?;
-    // The base colour: an image by URI (relative to the glTF file) on texture coordinate set
-    // 0. Embedded images (buffer views, data URIs) and other sets are not read.
-    let mut color_texture = None;
-    let mut other_textures = pbr.metallic_roughness_texture.is_some()
-        || m.normal_texture.is_some()
-        || m.occlusion_texture.is_some()
-        || m.emissive_texture.is_some();
-    if let Some(info) = &pbr.base_color_texture {
-        let t = exists(info.index.value(), root.textures.len(), "texture").map_err(|e| {
-            format!("materials[{index}].pbrMetallicRoughness.baseColorTexture.index: {e}")
-        })?;
-        let image = &root.images[root.textures[t].source.value()];
-        color_texture = image
-            .uri
-            .as_deref()
-            .filter(|uri| info.tex_coord == 0 && !uri.starts_with("data:"))
-            .and_then(|uri| resolve_uri(uri, dir).ok());
-        // Not read (embedded, on another set, an http: URI): ignored with the others.
-        other_textures |= color_texture.is_none();
+    // Occlusion maps are for rasterisers (a path tracer finds the occlusion), so they are
+    // ignored without a word.
+    let mut other_textures = false;
+    let mut image = |info: &Option<json::texture::Info>, field: &str| {
+        let Some(info) = info else {
+            return Ok(None);
+        };
+        let field = format!("materials[{index}].{field}");
+        let t = exists(info.index.value(), root.textures.len(), "texture")
+            .map_err(|e| format!("{field}.index: {e}"))?;
+        let transform = info
+            .extensions
+            .as_ref()
+            .and_then(|e| e.texture_transform.as_ref());
+        // KHR_texture_transform's texCoord overrides the reference's.
+        let tex_coord = transform
+            .and_then(|t| t.tex_coord)
+            .unwrap_or(info.tex_coord);
+        if tex_coord != 0 {
+            warnings.push(format!(
+                "{field}: on TEXCOORD_{tex_coord}; glint reads TEXCOORD_0 only, so the texture is \
+                 ignored"
+            ));
+            return Ok(None);
+        }
+        let mut sampling = Sampling::default();
+        if let Some(s) = root.textures[t].sampler {
+            let s = exists(s.value(), root.samplers.len(), "sampler")
+                .map_err(|e| format!("textures[{t}].sampler: {e}"))?;
+            let sampler = &root.samplers[s];
+            for (axis, (mode, name)) in [(sampler.wrap_s, "wrapS"), (sampler.wrap_t, "wrapT")]
+                .into_iter()
+                .enumerate()
+            {
+                sampling.wrap[axis] = match mode {
+                    Checked::Valid(WrappingMode::Repeat) => TEXTURE_WRAP_REPEAT,
+                    Checked::Valid(WrappingMode::ClampToEdge) => TEXTURE_WRAP_CLAMP,
+                    Checked::Valid(WrappingMode::MirroredRepeat) => TEXTURE_WRAP_MIRROR,
+                    Checked::Invalid => {
+                        return Err(format!("samplers[{s}].{name}: not a glTF wrap mode"))
+                    }
+                };
+            }
+            // Without mipmaps, the magnification filter decides.
+            sampling.nearest = sampler.mag_filter == Some(Checked::Valid(MagFilter::Nearest));
+        }
+        if let Some(t) = transform {
+            let [ox, oy] = t.offset.0;
+            let [sx, sy] = t.scale.0;
+            let (sin, cos) = t.rotation.0.sin_cos();
+            // glTF's uv' = T R S uv, R rotating the UVs counterclockwise as the extension's text
+            // says, drawn with glTF's v down: u' = cos sx u + sin sy v + ox, v' = −sin sx u +
+            // cos sy v + oy. (The GLSL snippet in the extension's README has the opposite sign;
+            // Khronos' TextureTransformTest, whose markers say which way is right, and three.js
+            // follow the text.) Here in glint's coordinates, whose v is 1 − glTF's.
+            sampling.transform = [
+                [cos * sx, -sin * sy, ox + sin * sy],
+                [sin * sx, cos * sy, 1.0 - cos * sy - oy],
+            ];
+            if !sampling.transform.iter().flatten().all(|c| c.is_finite()) {
+                return Err(format!(
+                    "{field}.extensions.KHR_texture_transform: not finite"
+                ));
+            }
+        }
+        Ok::<_, String>(Some((root.textures[t].source.value(), sampling)))
+    };
+    let maps = MaterialImages {
+        color: image(
+            &pbr.base_color_texture,
+            "pbrMetallicRoughness.baseColorTexture",
+        )?,
+        metallic_roughness: image(
+            &pbr.metallic_roughness_texture,
+            "pbrMetallicRoughness.metallicRoughnessTexture",
+        )?,
+        // Without emission the texture multiplies nothing.
+        emission: if emission == Vec3::ZERO {
+            None
+        } else {
+            image(&m.emissive_texture, "emissiveTexture")?
+        },
+        normal: match &m.normal_texture {
+            Some(n) => {
+                let field = format!("materials[{index}].normalTexture");
+                if !n.scale.is_finite() {
+                    return Err(format!("{field}.scale: not finite"));
+                }
+                // The crate keeps a normal texture's extensions unparsed.
+                let transform = n
+                    .extensions
+                    .as_ref()
+                    .and_then(|e| e.others.get("KHR_texture_transform"))
+                    .map(|v| {
+                        serde_json::from_value(v.clone())
+                            .map_err(|e| format!("{field}.extensions.KHR_texture_transform: {e}"))
+                    })
+                    .transpose()?;
+                let info = json::texture::Info {
+                    index: n.index,
+                    tex_coord: n.tex_coord,
+                    extensions: Some(json::extensions::texture::Info {
+                        texture_transform: transform,
+                        others: Default::default(),
+                    }),
+                    extras: Default::default(),
+                };
+                image(&Some(info), "normalTexture")?.map(|i| (i, n.scale))
+            }
+            None => None,
+        },
+    };
+    if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
+        other_textures |=
+            specular.specular_texture.is_some() || specular.specular_color_texture.is_some();
     }
     Ok((
         Material {
@@ -439,10 +593,61 @@ fn material(
             emitted_radiance: emission,
             color_texture: None,
             roughness_texture: None,
+            emission_texture: None,
+            normal_texture: None,
         },
-        color_texture,
+        maps,
         other_textures,
     ))
+}
+
+/// The images (indices into `images`) of a material's texture maps, and how each is sampled.
+struct MaterialImages {
+    color: Option<(usize, Sampling)>,
+    metallic_roughness: Option<(usize, Sampling)>,
+    emission: Option<(usize, Sampling)>,
+    /// The normal map and its scale.
+    normal: Option<((usize, Sampling), f32)>,
+}
+
+/// Where image `i` comes from: a file its URI names, or bytes in the glTF file (a buffer view
+/// or a base64 `data:` URI), which must be a PNG or JPEG image as glTF requires.
+fn image_source(
+    root: &json::Root,
+    buffers: &Buffers,
+    i: usize,
+    dir: &Path,
+) -> Result<ImageSource, String> {
+    let element = format!("images[{i}]");
+    let image = &root.images[i];
+    let bytes: Vec<u8> = match (&image.uri, image.buffer_view) {
+        (Some(uri), _) if !uri.starts_with("data:") => {
+            return Ok(ImageSource::File(
+                resolve_uri(uri, dir).map_err(|e| format!("{element}: {e}"))?,
+            ))
+        }
+        (Some(uri), _) => read_uri(uri, dir, "image").map_err(|e| format!("{element}: {e}"))?,
+        (None, Some(v)) => {
+            // Inside its buffer: check_buffer_views saw it fit.
+            let view = &root.buffer_views[v.value()];
+            let start = view.byte_offset.map_or(0, |o| o.0) as usize;
+            buffers.data[view.buffer.value()][start..start + view.byte_length.0 as usize].to_vec()
+        }
+        (None, None) => return Err(format!("{element}: neither a uri nor a bufferView")),
+    };
+    match image::guess_format(&bytes) {
+        Ok(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        Ok(other) => {
+            return Err(format!(
+                "{element}: a {other:?} image; glTF images glint reads are PNG and JPEG"
+            ))
+        }
+        Err(_) => return Err(format!("{element}: not a PNG or JPEG image")),
+    }
+    Ok(ImageSource::Embedded {
+        element,
+        bytes: bytes.into(),
+    })
 }
 
 /// A primitive, checked, with the accessors to read.
@@ -450,6 +655,7 @@ struct PrimitivePlan {
     positions: usize,
     normals: Option<usize>,
     uvs: Option<usize>,
+    tangents: Option<usize>,
     indices: Option<usize>,
     material: Option<usize>,
     triangles: u64,
@@ -486,7 +692,12 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             .ok_or_else(|| format!("{name}.attributes: no POSITION"))?;
         let normals = attribute(Semantic::Normals, "NORMAL", Type::Vec3)?;
         let uvs = attribute(Semantic::TexCoords(0), "TEXCOORD_0", Type::Vec2)?;
-        for (label, other) in [("NORMAL", normals), ("TEXCOORD_0", uvs)] {
+        let tangents = attribute(Semantic::Tangents, "TANGENT", Type::Vec4)?;
+        for (label, other) in [
+            ("NORMAL", normals),
+            ("TEXCOORD_0", uvs),
+            ("TANGENT", tangents),
+        ] {
             if let Some((a, count)) = other {
                 if count != vertices {
                     return Err(format!(
@@ -515,6 +726,7 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             positions,
             normals: normals.map(|(a, _)| a),
             uvs: uvs.map(|(a, _)| a),
+            tangents: tangents.map(|(a, _)| a),
             indices: indices.map(|(a, _)| a),
             material,
             triangles: indices.map_or(vertices, |(_, count)| count) as u64 / 3,
@@ -895,6 +1107,18 @@ impl Decoder<'_> {
                 .collect(),
             None => Vec::new(),
         };
+        // glTF's tangents point along increasing u, and their w (±1) makes the bitangent
+        // w · normal × tangent point along increasing v of glTF's v-up normal-map convention,
+        // which is glint's v: both are kept as they are.
+        let tangents = match plan.tangents {
+            Some(a) => self
+                .layout(a, Type::Vec4, false)?
+                .floats::<4>()?
+                .into_iter()
+                .map(Vec4::from)
+                .collect(),
+            None => Vec::new(),
+        };
         let flat: Vec<u32> = match plan.indices {
             Some(a) => self.layout(a, Type::Scalar, true)?.indices()?,
             None => (0..positions.len() as u32).collect(),
@@ -903,6 +1127,7 @@ impl Decoder<'_> {
             positions,
             normals,
             uvs,
+            tangents,
             indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         })
     }

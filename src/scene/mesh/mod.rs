@@ -13,15 +13,16 @@ mod gltf_lights;
 mod gltf_nodes;
 mod obj;
 mod ply;
+mod tangents;
 
 pub use gltf_cameras::{gltf_camera, no_such_camera, FileCamera};
 pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
-use super::texture::{TextureSet, TextureUse};
+use super::texture::{Sampling, TextureSet, TextureUse};
 use super::{Material, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -65,6 +66,9 @@ pub(super) struct Geometry {
     normals: Vec<Vec3>,
     /// Texture coordinates (v up), as many as positions, or none.
     uvs: Vec<Vec2>,
+    /// glTF's TANGENT (xyz along increasing u, w the bitangent's sign), as many as positions,
+    /// or none.
+    tangents: Vec<Vec4>,
     indices: Vec<[u32; 3]>,
 }
 
@@ -96,12 +100,38 @@ impl MeshPart {
 pub(super) struct MeshFile {
     parts: Vec<MeshPart>,
     materials: Vec<Material>,
-    /// Per material: its colour texture's file (OBJ `map_Kd`, glTF `baseColorTexture` by URI).
-    color_textures: Vec<Option<PathBuf>>,
+    /// Per material: the images of its texture maps.
+    textures: Vec<FileTextures>,
     /// Whether any material refers to a texture glint does not use (normal maps, ...).
     has_other_textures: bool,
     /// Anything else worth a warning line, each a sentence without the file's name.
     warnings: Vec<String>,
+}
+
+/// Where a texture's image comes from.
+pub(super) enum ImageSource {
+    File(PathBuf),
+    /// An image file's bytes inside the mesh file (a glTF buffer view or `data:` URI), and the
+    /// element that holds them (`images[2]`), for messages.
+    Embedded {
+        element: String,
+        bytes: Rc<[u8]>,
+    },
+}
+
+/// A material's texture maps, as images (shared between the materials that use them).
+#[derive(Default)]
+pub(super) struct FileTextures {
+    /// Multiplies the material's colour (OBJ `map_Kd`, whose colour is then 1; glTF
+    /// `baseColorTexture`).
+    color: Option<(Rc<ImageSource>, Sampling)>,
+    /// glTF's `metallicRoughnessTexture`: green multiplies the roughness, blue the metallic
+    /// factor.
+    metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
+    /// glTF's `emissiveTexture` (sRGB), multiplying the emission.
+    emission: Option<(Rc<ImageSource>, Sampling)>,
+    /// glTF's `normalTexture` (linear), and its scale.
+    normal: Option<((Rc<ImageSource>, Sampling), f32)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -152,7 +182,8 @@ pub(crate) fn load(
         .collect();
     if file.has_other_textures {
         warnings.push(format!(
-            "{shown}: texture maps other than the base colour (normal, roughness, emission, ...) are ignored"
+            "{shown}: texture maps other than the base colour, metallic-roughness, emission and \
+             normal maps (KHR_materials_specular's) are ignored"
         ));
     }
     // The file's materials become scene materials, but only when they are used.
@@ -165,6 +196,8 @@ pub(crate) fn load(
     let mut triangles = Vec::new();
     let mut degenerate = 0usize;
     let mut checked = std::collections::HashSet::new();
+    let mut tangent_cache: std::collections::HashMap<*const Geometry, Rc<Vec<[Vec4; 3]>>> =
+        std::collections::HashMap::new();
     for part in &file.parts {
         let matrix = scene_matrix * part.transform;
         // Normals go through the inverse transpose of the linear part.
@@ -203,16 +236,24 @@ pub(crate) fn load(
                     Some(m) => m,
                     None => {
                         let mut m = file.materials[index].clone();
-                        if let Some(texture) = &file.color_textures[index] {
-                            let index =
-                                textures.image(texture, TextureUse::Color).map_err(|e| {
-                                    format!(
-                                        "material {:?}: texture {}: {e}",
-                                        m.name,
-                                        texture.display()
-                                    )
-                                })?;
-                            m.color_texture = Some(index);
+                        let maps = &file.textures[index];
+                        let name = m.name.clone();
+                        let mut load = |map: &Option<(Rc<ImageSource>, Sampling)>, usage| {
+                            map.as_ref()
+                                .map(|(source, sampling)| {
+                                    let image =
+                                        texture(source, usage, path, shown, &name, textures)?;
+                                    Ok::<_, String>(textures.sampled(image, sampling))
+                                })
+                                .transpose()
+                        };
+                        m.color_texture = load(&maps.color, TextureUse::Color)?;
+                        m.roughness_texture =
+                            load(&maps.metallic_roughness, TextureUse::MetallicRoughness)?;
+                        m.emission_texture = load(&maps.emission, TextureUse::Color)?;
+                        if let Some((map, scale)) = &maps.normal {
+                            m.normal_texture =
+                                load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
                         }
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;
@@ -224,6 +265,30 @@ pub(crate) fn load(
             }
         };
         let count = geometry.positions.len();
+        // Normal maps need tangents at every corner (tangents.rs), read or made once per
+        // geometry.
+        let corners = if scene_materials[material as usize].normal_texture.is_some() {
+            if geometry.uvs.len() != count {
+                return Err(format!(
+                    "{shown}: {}material {:?} has a normal map, but these triangles have no \
+                     texture coordinates (TEXCOORD_0) to lay it out",
+                    part_prefix(&part.name),
+                    scene_materials[material as usize].name
+                ));
+            }
+            let key = Rc::as_ptr(&part.geometry);
+            Some(
+                tangent_cache
+                    .entry(key)
+                    .or_insert_with(|| {
+                        Rc::new(tangents::corner_tangents(geometry).unwrap_or_default())
+                    })
+                    .clone(),
+            )
+        } else {
+            None
+        };
+        let linear = Mat3::from_mat4(matrix);
         for (f, idx) in geometry.indices.iter().enumerate() {
             if let Some(&bad) = idx.iter().find(|&&i| i as usize >= count) {
                 return Err(format!(
@@ -251,11 +316,16 @@ pub(crate) fn load(
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
             let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+            let tangents = corners
+                .as_ref()
+                .and_then(|c| c.get(f))
+                .map(|c| c.map(|t| tangents::placed_tangent(&linear, t)));
             triangles.push(Triangle {
                 vertices: v,
                 normals,
                 material,
                 uvs,
+                tangents,
             });
             if triangles.len() > MAX_TRIANGLES {
                 return Err(format!(
@@ -284,6 +354,26 @@ pub(crate) fn load(
         triangles,
         warnings,
     })
+}
+
+/// The texture of an image a mesh file's material refers to; the error names the material
+/// and the image (its file, or the mesh file and element that hold it).
+fn texture(
+    source: &ImageSource,
+    usage: TextureUse,
+    mesh_path: &Path,
+    shown: &str,
+    material: &str,
+    textures: &mut TextureSet,
+) -> Result<u32, String> {
+    match source {
+        ImageSource::File(file) => textures
+            .image(file, usage)
+            .map_err(|e| format!("material {material:?}: texture {}: {e}", file.display())),
+        ImageSource::Embedded { element, bytes } => textures
+            .embedded_image(mesh_path, element, bytes, usage)
+            .map_err(|e| format!("{shown}: material {material:?}: {element}: {e}")),
+    }
 }
 
 /// A reader's message on one line: runs of whitespace (newlines, tabs) become one space.

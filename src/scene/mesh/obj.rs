@@ -1,13 +1,15 @@
 //! OBJ files and their `.mtl` materials, read by `tobj`.
 
 use super::{
-    check_emission, check_ior, check_reflectance, read_mesh_bytes, Geometry, MeshFile, MeshPart,
+    check_emission, check_ior, check_reflectance, read_mesh_bytes, FileTextures, Geometry,
+    ImageSource, MeshFile, MeshPart,
 };
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Material, MaterialKind};
 use glam::{Vec2, Vec3};
 use std::io::{BufRead, Read};
 use std::path::Path;
+use std::rc::Rc;
 
 /// A reader that counts the lines consumed, so an OBJ error can name the line tobj stopped at
 /// (tobj's errors carry none).
@@ -83,6 +85,8 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
             emitted_radiance: emission,
             color_texture: None,
             roughness_texture: None,
+            emission_texture: None,
+            normal_texture: None,
         },
         textures,
     ))
@@ -112,15 +116,23 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
     let materials = materials.unwrap_or_default();
     let mut has_other_textures = false;
     let mut converted = Vec::new();
-    let mut color_textures = Vec::new();
+    let mut file_textures = Vec::new();
     for m in &materials {
-        let (material, textures) = obj_material(m)?;
+        let (mut material, textures) = obj_material(m)?;
         // map_Kd is the diffuse colour: mirrors (Ks) and glass (clear) do not use it. Relative
         // to the OBJ's folder, as tobj reads the .mtl from there.
         let map_kd = m.diffuse_texture.as_ref().map(|t| dir.join(t.trim()));
         let diffuse = material.kind == MaterialKind::Diffuse;
         has_other_textures |= textures || (map_kd.is_some() && !diffuse);
-        color_textures.push(map_kd.filter(|_| diffuse));
+        let map_kd = map_kd.filter(|_| diffuse);
+        if map_kd.is_some() {
+            // map_Kd replaces Kd (the kernel multiplies the colour by the texture).
+            material.color = Vec3::ONE;
+        }
+        file_textures.push(FileTextures {
+            color: map_kd.map(|path| (Rc::new(ImageSource::File(path)), Default::default())),
+            ..Default::default()
+        });
         converted.push(material);
     }
     let parts = models
@@ -136,6 +148,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
                         .chunks_exact(2)
                         .map(Vec2::from_slice)
                         .collect(),
+                    tangents: Vec::new(),
                     indices: mesh
                         .indices
                         .chunks_exact(3)
@@ -150,7 +163,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
     Ok(MeshFile {
         parts,
         materials: converted,
-        color_textures,
+        textures: file_textures,
         has_other_textures,
         warnings: Vec::new(),
     })

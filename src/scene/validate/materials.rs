@@ -296,6 +296,8 @@ pub(super) fn validate_materials(
             emitted_radiance: emission * strength,
             color_texture,
             roughness_texture,
+            emission_texture: None,
+            normal_texture: None,
         });
     }
     Ok(Materials {

@@ -1,0 +1,494 @@
+//! glTF materials as glint reads them: the metallic-roughness model and its extensions onto
+//! `pbr`, images embedded in the file, and the texture maps glTF defines. Each test writes a
+//! small generated glTF file (one triangle) beside a scene that uses the file's materials.
+
+mod common;
+
+use glam::Vec3;
+use glint::scene::{MaterialKind, Scene};
+
+const SCENE: &str = r#"[camera]
+eye = [0.0, 0.0, -5.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+
+[render]
+width = 8
+height = 8
+spp = 1
+max_bounces = 1
+
+[[meshes]]
+file = "t.gltf"
+"#;
+
+/// One triangle with normals and texture coordinates in an external buffer, `tri.bin`, and
+/// `material` as its only material.
+fn triangle_gltf(material: serde_json::Value) -> (serde_json::Value, Vec<u8>) {
+    let floats: [f32; 24] = [
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, // positions
+        0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, // normals
+        0.0, 0.0, 1.0, 0.0, 0.0, 1.0, // texture coordinates
+    ];
+    let mut bin: Vec<u8> = floats.iter().flat_map(|f| f.to_le_bytes()).collect();
+    bin.extend([0u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()));
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{
+            "attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2},
+            "indices": 3,
+            "material": 0
+        }]}],
+        "materials": [material],
+        "buffers": [{"uri": "tri.bin", "byteLength": 104}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 72, "byteLength": 24},
+            {"buffer": 0, "byteOffset": 96, "byteLength": 6}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": 3, "type": "SCALAR"}
+        ]
+    });
+    (json, bin)
+}
+
+/// Writes the glTF `json` and its buffer with the scene into a fresh folder.
+fn write(json: &serde_json::Value, bin: &[u8]) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("t.gltf"), serde_json::to_vec(json).unwrap()).unwrap();
+    std::fs::write(dir.path().join("tri.bin"), bin).unwrap();
+    std::fs::write(dir.path().join("scene.toml"), SCENE).unwrap();
+    dir
+}
+
+fn load(json: &serde_json::Value, bin: &[u8]) -> Result<Scene, String> {
+    let dir = write(json, bin);
+    Scene::load(&dir.path().join("scene.toml")).map_err(|e| e.to_string())
+}
+
+/// The scene material the file's material became.
+fn loaded_material(material: serde_json::Value) -> glint::scene::Material {
+    let (json, bin) = triangle_gltf(material);
+    let scene = load(&json, &bin).unwrap_or_else(|e| panic!("{e}"));
+    scene.materials[scene.triangles[0].material as usize].clone()
+}
+
+/// The warning lines `glint render --cpu` prints for the file.
+fn render_warnings(json: &serde_json::Value, bin: &[u8]) -> Vec<String> {
+    let dir = write(json, bin);
+    let out = dir.path().join("out.png");
+    let run = common::run_render("--cpu", &dir.path().join("scene.toml"), &out);
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    stderr
+        .lines()
+        .filter(|l| l.contains("warning"))
+        .map(str::to_owned)
+        .collect()
+}
+
+#[test]
+fn metallic_roughness_factors_and_extensions_become_pbr() {
+    let m = loaded_material(serde_json::json!({
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [0.8, 0.5, 0.25, 1.0],
+            "metallicFactor": 0.25,
+            "roughnessFactor": 0.6
+        },
+        "emissiveFactor": [0.5, 0.25, 1.0],
+        "extensions": {
+            "KHR_materials_ior": {"ior": 1.33},
+            "KHR_materials_specular": {
+                "specularFactor": 0.7,
+                "specularColorFactor": [1.0, 0.5, 2.0]
+            },
+            "KHR_materials_emissive_strength": {"emissiveStrength": 4.0}
+        }
+    }));
+    assert_eq!(
+        m.kind,
+        MaterialKind::Pbr {
+            roughness: 0.6,
+            metallic: 0.25,
+            ior: 1.33,
+            specular: 0.7,
+            specular_color: Vec3::new(1.0, 0.5, 2.0),
+        }
+    );
+    assert_eq!(m.color, Vec3::new(0.8, 0.5, 0.25));
+    assert_eq!(m.emitted_radiance, Vec3::new(2.0, 1.0, 4.0));
+    assert_eq!(m.name, "t.gltf/material0");
+}
+
+/// An empty material is glTF's default: white, fully metallic, fully rough (not glint's TOML
+/// defaults, roughness 0.5 and metallic 0).
+#[test]
+fn absent_factors_take_gltfs_defaults() {
+    let m = loaded_material(serde_json::json!({}));
+    assert_eq!(
+        m.kind,
+        MaterialKind::Pbr {
+            roughness: 1.0,
+            metallic: 1.0,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+        }
+    );
+    assert_eq!(m.color, Vec3::ONE);
+    assert_eq!(m.emitted_radiance, Vec3::ZERO);
+}
+
+/// Transmission stays a smooth dielectric, with a warning that says what is lost.
+#[test]
+fn transmission_is_a_smooth_dielectric_with_a_warning() {
+    let material = serde_json::json!({
+        "pbrMetallicRoughness": {"roughnessFactor": 0.3},
+        "extensions": {
+            "KHR_materials_transmission": {"transmissionFactor": 0.4},
+            "KHR_materials_ior": {"ior": 1.4}
+        }
+    });
+    let m = loaded_material(material.clone());
+    assert_eq!(m.kind, MaterialKind::Dielectric { ior: 1.4 });
+    let (json, bin) = triangle_gltf(material);
+    let warnings = render_warnings(&json, &bin);
+    assert!(
+        warnings.iter().any(|w| w.contains("materials[0]")
+            && w.contains("KHR_materials_transmission 0.4")
+            && w.contains("smooth")),
+        "{warnings:?}"
+    );
+}
+
+/// Factors outside glTF's ranges are errors naming the material and the factor.
+#[test]
+fn factors_out_of_range_are_errors() {
+    for (material, needles) in [
+        (
+            serde_json::json!({"pbrMetallicRoughness": {"roughnessFactor": 1.5}}),
+            &["material0", "roughnessFactor must be in [0, 1]", "1.5"][..],
+        ),
+        (
+            serde_json::json!({"pbrMetallicRoughness": {"metallicFactor": -0.5}}),
+            &["material0", "metallicFactor must be in [0, 1]"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_specular": {"specularFactor": 2}}}),
+            &["material0", "specularFactor must be in [0, 1]"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_specular":
+                {"specularColorFactor": [1, -1, 1]}}}),
+            &["material0", "specularColorFactor must be ≥ 0"][..],
+        ),
+    ] {
+        let (json, bin) = triangle_gltf(material);
+        let message = load(&json, &bin).expect_err("the material should be refused");
+        for needle in ["scene.toml:", "meshes[0].file", "t.gltf: "]
+            .iter()
+            .chain(needles)
+        {
+            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+        }
+    }
+}
+
+/// A 2×2 PNG with these texels, top row first.
+fn png(texels: [[u8; 3]; 4]) -> Vec<u8> {
+    let image = image::RgbImage::from_fn(2, 2, |x, y| image::Rgb(texels[(y * 2 + x) as usize]));
+    let mut bytes = Vec::new();
+    image
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .unwrap();
+    bytes
+}
+
+const COLOR_TEXELS: [[u8; 3]; 4] = [[255, 0, 0], [0, 255, 0], [0, 0, 255], [128, 64, 32]];
+/// Roughness in green, metallic in blue; red is glTF's occlusion, unused.
+const METALLIC_ROUGHNESS_TEXELS: [[u8; 3]; 4] =
+    [[9, 255, 0], [9, 128, 255], [9, 0, 64], [9, 51, 204]];
+
+/// A binary glTF: the triangle's buffer then `images` in its BIN chunk (each in a buffer
+/// view), with `edit` applied to the JSON.
+fn glb(
+    material: serde_json::Value,
+    images: &[Vec<u8>],
+    edit: impl FnOnce(&mut serde_json::Value),
+) -> Vec<u8> {
+    let (mut json, mut bin) = triangle_gltf(material);
+    json["images"] = serde_json::json!([]);
+    for image in images {
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        let view = json["bufferViews"].as_array().unwrap().len();
+        json["bufferViews"].as_array_mut().unwrap().push(
+            serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": image.len()}),
+        );
+        json["images"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!({"bufferView": view, "mimeType": "image/png"}));
+        bin.extend(image);
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    json["buffers"] = serde_json::json!([{"byteLength": bin.len()}]);
+    edit(&mut json);
+    let mut text = serde_json::to_vec(&json).unwrap();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + text.len() + 8 + bin.len()) as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(text);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+fn load_glb(bytes: &[u8]) -> Result<Scene, String> {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("t.glb"), bytes).unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, SCENE.replace("t.gltf", "t.glb")).unwrap();
+    Scene::load(&scene).map_err(|e| e.to_string())
+}
+
+/// The textured material: base colour from a data: URI, metallic-roughness from the .glb's
+/// buffer view, both multiplying their factors.
+fn textured_glb() -> Vec<u8> {
+    use base64::Engine as _;
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(png(COLOR_TEXELS))
+    );
+    let material = serde_json::json!({"pbrMetallicRoughness": {
+        "baseColorFactor": [0.5, 1.0, 0.25, 1.0],
+        "metallicFactor": 0.5,
+        "roughnessFactor": 0.8,
+        "baseColorTexture": {"index": 0},
+        "metallicRoughnessTexture": {"index": 1}
+    }});
+    glb(material, &[png(METALLIC_ROUGHNESS_TEXELS)], |g| {
+        g["images"]
+            .as_array_mut()
+            .unwrap()
+            .push(serde_json::json!({"uri": uri}));
+        g["textures"] = serde_json::json!([{"source": 1}, {"source": 0}]);
+    })
+}
+
+/// At each texel centre, on both devices, the material's colour is baseColorFactor × the
+/// sRGB-decoded texel, its roughness roughnessFactor × green and its metallic metallicFactor
+/// × blue (the texels are exact at power-of-two texel centres, tests/textures.rs; the
+/// products are the same f32 operations on both sides, so they agree to an ulp or two).
+#[test]
+fn embedded_textures_multiply_their_factors_on_both_devices() {
+    use glint::cpu::texture::{material_at, Textures};
+    let scene = load_glb(&textured_glb()).unwrap_or_else(|e| panic!("{e}"));
+    let index = scene.triangles[0].material;
+    let scene = scene.kernel_scene();
+    let material = scene.materials[index as usize];
+    let textures = Textures {
+        descriptors: &scene.textures,
+        texels: &scene.texels,
+    };
+    // Kernel texture coordinates have v up: texel (x, y) from the image's top left is at
+    // ((x + 0.5)/2, 1 − (y + 0.5)/2).
+    let centres: Vec<(usize, glam::Vec2)> = (0..4)
+        .map(|i| {
+            let (x, y) = ((i % 2) as f32, (i / 2) as f32);
+            (i, glam::Vec2::new((x + 0.5) / 2.0, 1.0 - (y + 0.5) / 2.0))
+        })
+        .collect();
+    let srgb = |c: u8| glint::scene::image::srgb_to_linear(c as f32 / 255.0);
+    let mut cpu = Vec::new();
+    for &(i, uv) in &centres {
+        let m = material_at(&textures, &material, uv);
+        let c = COLOR_TEXELS[i];
+        let want = Vec3::new(0.5 * srgb(c[0]), srgb(c[1]), 0.25 * srgb(c[2]));
+        assert!(
+            (Vec3::from(m.albedo) - want).abs().max_element() < 1e-6,
+            "texel {i}: colour {:?}, want {want}",
+            m.albedo
+        );
+        let [_, g, b] = METALLIC_ROUGHNESS_TEXELS[i];
+        let roughness = 0.8 * (g as f32 / 255.0);
+        assert!(
+            (m.alpha - roughness * roughness).abs() < 1e-6,
+            "texel {i}: alpha {}",
+            m.alpha
+        );
+        assert!(
+            (m.metallic - 0.5 * (b as f32 / 255.0)).abs() < 1e-6,
+            "texel {i}: metallic {}",
+            m.metallic
+        );
+        cpu.push([m.albedo[0], m.albedo[1], m.albedo[2], m.alpha]);
+        cpu.push([m.metallic, 0.0, 0.0, 0.0]);
+    }
+    let Some(ctx) = common::gpu() else { return };
+    let mut probed = scene.clone();
+    probed.triangle_uvs = centres
+        .iter()
+        .map(|(_, uv)| glint::shader_types::TriangleUvs {
+            uv0: uv.to_array(),
+            ..Default::default()
+        })
+        .collect();
+    let params = common::probe::ProbeParams {
+        count: cpu.len() as u32,
+        seed: index,
+        ..Default::default()
+    };
+    let gpu = common::probe::run_probe(ctx, "probe_material_at", params, &probed);
+    for (k, (c, g)) in cpu.iter().zip(&gpu).enumerate() {
+        for (a, b) in c.iter().zip(g) {
+            assert!((a - b).abs() <= 1e-6, "entry {k}: CPU {c:?}, GPU {g:?}");
+        }
+    }
+}
+
+/// Embedded images that cannot be used are errors naming the file and the element.
+#[test]
+fn bad_embedded_images_name_their_element() {
+    let material =
+        || serde_json::json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}});
+    let with = |images: &[Vec<u8>], edit: &dyn Fn(&mut serde_json::Value)| {
+        let bytes = glb(material(), images, |g| {
+            g["textures"] = serde_json::json!([{"source": 0}]);
+            edit(g);
+        });
+        load_glb(&bytes).expect_err("the file should be refused")
+    };
+    let mut cut = png(COLOR_TEXELS);
+    cut.truncate(40);
+    for (message, needles) in [
+        (
+            with(&[cut], &|_| {}),
+            &["t.glb", "images[0]", "cannot decode"][..],
+        ),
+        (
+            with(&[b"GIF89a\x01\x00\x01\x00\x00\x00\x00;".to_vec()], &|_| {}),
+            &["t.glb", "images[0]", "Gif image", "PNG and JPEG"][..],
+        ),
+        (
+            with(&[png(COLOR_TEXELS)], &|g| {
+                g["images"][0]["bufferView"] = 5.into()
+            }),
+            &[
+                "t.glb",
+                "images[0].bufferView",
+                "buffer view 5 does not exist",
+            ][..],
+        ),
+        (
+            with(&[], &|g| {
+                g["images"] = serde_json::json!([{"uri": "data:image/png;base64,@@@"}])
+            }),
+            &["t.glb", "images[0]", "base64"][..],
+        ),
+    ] {
+        for needle in needles {
+            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+        }
+        assert!(!message.contains('\n'), "{message:?}");
+    }
+}
+
+/// A texture on TEXCOORD_1 is left out with a warning (glint reads TEXCOORD_0 only).
+#[test]
+fn a_texture_on_the_second_coordinate_set_is_a_warning() {
+    let material = serde_json::json!({"pbrMetallicRoughness": {
+        "baseColorTexture": {"index": 0, "texCoord": 1}
+    }});
+    let (mut json, bin) = triangle_gltf(material);
+    json["images"] = serde_json::json!([{"uri": "missing.png"}]);
+    json["textures"] = serde_json::json!([{"source": 0}]);
+    let warnings = render_warnings(&json, &bin);
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("baseColorTexture: on TEXCOORD_1")),
+        "{warnings:?}"
+    );
+}
+
+/// A texture's sampler (wrap modes, magnification filter) and KHR_texture_transform reach its
+/// descriptor, the transform converted to glint's v-up coordinates: for glint's (u, v), the
+/// descriptor's map gives what the extension's T·R·S (written out here independently, the
+/// rotation counterclockwise with v down as its text says and TextureTransformTest.gltf
+/// checks, tests/gltf_samples.rs) gives for glTF's (u, 1 − v), with v flipped back.
+#[test]
+fn samplers_and_texture_transforms_reach_the_descriptor() {
+    use glint::shader_types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
+    let (offset, rotation, scale) = ([0.25f32, -0.5], 0.5f32, [2.0f32, 3.0]);
+    let material = serde_json::json!({"pbrMetallicRoughness": {
+        "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+            "offset": offset, "rotation": rotation, "scale": scale
+        }}}
+    }});
+    let bytes = glb(material, &[png(COLOR_TEXELS)], |g| {
+        g["textures"] = serde_json::json!([{"source": 0, "sampler": 0}]);
+        g["samplers"] = serde_json::json!([{"wrapS": 33071, "wrapT": 33648, "magFilter": 9728}]);
+        g["extensionsUsed"] = serde_json::json!(["KHR_texture_transform"]);
+        g["extensionsRequired"] = serde_json::json!(["KHR_texture_transform"]);
+    });
+    let scene = load_glb(&bytes).unwrap_or_else(|e| panic!("{e}"));
+    let index = scene.triangles[0].material as usize;
+    let scene = scene.kernel_scene();
+    let t = scene.textures[scene.materials[index].color_texture as usize];
+    assert_eq!(
+        t.sampling,
+        TEXTURE_WRAP_CLAMP | (TEXTURE_WRAP_MIRROR << 8) | TEXTURE_NEAREST
+    );
+    let (s, c) = rotation.sin_cos();
+    let translation =
+        glam::Mat3::from_cols_array(&[1., 0., 0., 0., 1., 0., offset[0], offset[1], 1.]);
+    let rotate = glam::Mat3::from_cols_array(&[c, -s, 0., s, c, 0., 0., 0., 1.]);
+    let scaling = glam::Mat3::from_cols_array(&[scale[0], 0., 0., 0., scale[1], 0., 0., 0., 1.]);
+    let matrix = translation * rotate * scaling;
+    for uv in [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0], [0.3, 0.7]] {
+        let gltf = matrix * Vec3::new(uv[0], 1.0 - uv[1], 1.0);
+        let want = glam::Vec2::new(gltf.x, 1.0 - gltf.y);
+        let got = glint::cpu::texture::transformed_uv(&t, glam::Vec2::from(uv));
+        assert!(
+            (got - want).abs().max_element() < 1e-5,
+            "at {uv:?}: {got} against {want}"
+        );
+    }
+}
+
+/// A sampler's wrap mode that is not one of glTF's is an error naming the sampler.
+#[test]
+fn an_unknown_wrap_mode_is_an_error() {
+    let material = serde_json::json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}});
+    let bytes = glb(material, &[png(COLOR_TEXELS)], |g| {
+        g["textures"] = serde_json::json!([{"source": 0, "sampler": 0}]);
+        g["samplers"] = serde_json::json!([{"wrapT": 1234}]);
+    });
+    let message = load_glb(&bytes).expect_err("the file should be refused");
+    for needle in ["t.glb", "samplers[0].wrapT", "wrap mode"] {
+        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    }
+}
