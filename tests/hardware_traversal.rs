@@ -6,30 +6,12 @@
 
 mod common;
 use common::probe::{run_probe_hardware, ProbeParams};
-use common::{gpu_with_ray_queries, render_cpu, PathAgreement};
+use common::{gpu_with_ray_queries, render_cpu, PathAgreement, MESH_SCENE_HEADER};
 use glint::cpu::intersect::NO_HIT;
 use glint::gpu::{GpuRenderer, Traversal};
 use glint::render::{render_image, Renderer};
 use glint::scene::stress::StressMesh;
 use glint::scene::Scene;
-
-const HEADER: &str = r#"
-[camera]
-eye = [0.0, 0.0, -10.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 40.0
-
-[render]
-width = 16
-height = 16
-spp = 1
-max_bounces = 4
-
-[materials.white]
-type = "diffuse"
-color = [0.5, 0.5, 0.5]
-"#;
 
 /// Issue 11's watertightness rays through the hardware traversal: 10⁶ rays from points inside
 /// a closed tessellated sphere aimed exactly at its vertices, edge midpoints and points on its
@@ -54,7 +36,7 @@ fn hardware_closed_mesh_leaks_at_edges_and_vertices() {
         std::fs::write(
             &path,
             format!(
-                "{HEADER}[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = {scale}\n"
+                "{MESH_SCENE_HEADER}[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = {scale}\n"
             ),
         )
         .unwrap();

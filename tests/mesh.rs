@@ -2,7 +2,7 @@
 //! vertices, and whole images with meshes against the same scenes without them.
 
 mod common;
-use common::{gpu, render_cpu, render_gpu, PathAgreement};
+use common::{gpu, render_cpu, render_gpu, PathAgreement, MESH_SCENE_HEADER};
 use glam::Vec3;
 use glint::cpu::intersect::{closest_primitive, first_hit_is, Geometry, NO_HIT};
 use glint::cpu::rng::Rng;
@@ -26,29 +26,11 @@ fn scene_with_stress_mesh(
     Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-const HEADER: &str = r#"
-[camera]
-eye = [0.0, 0.0, -10.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 40.0
-
-[render]
-width = 16
-height = 16
-spp = 1
-max_bounces = 4
-
-[materials.white]
-type = "diffuse"
-color = [0.5, 0.5, 0.5]
-"#;
-
 /// A stress mesh, 40 random spheres and 40 random quads, all in one BVH.
 fn mixed_scene(dir: &std::path::Path) -> KernelScene {
     let mut rng = Rng::new(1, 2, 3, 4);
     let mut u = || rng.next_f32();
-    let mut toml = HEADER.to_string();
+    let mut toml = MESH_SCENE_HEADER.to_string();
     toml += "[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = 3.0\nrotate = [10.0, 20.0, 30.0]\n";
     for _ in 0..40 {
         toml += &format!(
@@ -160,8 +142,9 @@ fn bvh_finds_the_brute_force_closest_hit() {
 #[test]
 fn closed_mesh_has_no_leaks_at_edges_and_vertices() {
     let dir = tempfile::tempdir().unwrap();
-    let toml =
-        format!("{HEADER}[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = 2.0\n");
+    let toml = format!(
+        "{MESH_SCENE_HEADER}[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = 2.0\n"
+    );
     let scene = scene_with_stress_mesh(dir.path(), 64, 32, &toml).kernel_scene();
     let refs = SceneRefs::of(&scene, &scene.params);
     let geometry = refs.geometry();
@@ -310,7 +293,7 @@ fn gpu_closed_mesh_has_no_leaks_at_edges_and_vertices() {
     let path = dir.path().join("scene.toml");
     std::fs::write(
         &path,
-        format!("{HEADER}[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = 3.0\n"),
+        format!("{MESH_SCENE_HEADER}[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\nscale = 3.0\n"),
     )
     .unwrap();
     let scene = Scene::load(&path).unwrap().kernel_scene();

@@ -285,3 +285,23 @@ pub fn with_light_sampling(scene: &Scene, on: bool, seed: u32) -> KernelScene {
         .unwrap()
         .kernel_scene()
 }
+
+/// A 16² camera 10 in front of the origin and a white diffuse material: the start of the
+/// mesh tests' scenes (tests/mesh.rs, tests/hardware_traversal.rs), which add `[[meshes]]`.
+pub const MESH_SCENE_HEADER: &str = r#"
+[camera]
+eye = [0.0, 0.0, -10.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+
+[render]
+width = 16
+height = 16
+spp = 1
+max_bounces = 4
+
+[materials.white]
+type = "diffuse"
+color = [0.5, 0.5, 0.5]
+"#;
