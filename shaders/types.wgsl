@@ -81,6 +81,11 @@ const MATERIAL_METAL: u32 = 2u;
 const MATERIAL_DIELECTRIC: u32 = 3u;
 const MATERIAL_PBR: u32 = 4u;
 
+// Material.alpha_mode: glTF's OPAQUE, MASK and BLEND.
+const ALPHA_OPAQUE: u32 = 0u;
+const ALPHA_MASK: u32 = 1u;
+const ALPHA_BLEND: u32 = 2u;
+
 struct Material {
     // Diffuse albedo, mirror reflectance, metal F0, or glass transmission tint.
     albedo: vec3<f32>,
@@ -105,6 +110,21 @@ struct Material {
     // normal_scale (normal_map.wgsl).
     normal_texture: u32,
     normal_scale: f32,
+    // glTF's alphaMode: ALPHA_OPAQUE, ALPHA_MASK or ALPHA_BLEND.
+    alpha_mode: u32,
+    // The base colour's alpha; the colour texture's alpha multiplies it. Read only where
+    // alpha_mode is not opaque.
+    opacity: f32,
+    // MASK: a hit whose alpha is below this is no hit.
+    alpha_cutoff: f32,
+    // PBR: the share of the dielectric base that transmits (KHR_materials_transmission).
+    transmission: f32,
+    // Texture whose x (glTF's R channel) multiplies transmission, or NO_TEXTURE.
+    transmission_texture: u32,
+    // PBR with transmission: the colour white light has after attenuation_distance inside the
+    // mesh (KHR_materials_volume, Beer-Lambert); distance 0 where there is none.
+    attenuation_color: vec3<f32>,
+    attenuation_distance: f32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;

@@ -122,8 +122,29 @@ pub struct Material {
     /// scaled by `normal_scale` (`src/cpu/normal_map.rs`).
     pub normal_texture: u32,
     pub normal_scale: f32,
-    pub _pad: u32,
+    /// glTF's alphaMode: [`ALPHA_OPAQUE`], [`ALPHA_MASK`] or [`ALPHA_BLEND`].
+    pub alpha_mode: u32,
+    /// The base colour's alpha (glTF's baseColorFactor.a); the colour texture's alpha
+    /// multiplies it. Read only where `alpha_mode` is not opaque.
+    pub opacity: f32,
+    /// MASK: a hit whose alpha is below this is no hit.
+    pub alpha_cutoff: f32,
+    /// PBR: the share of the dielectric base that transmits (KHR_materials_transmission).
+    pub transmission: f32,
+    /// Texture whose x (glTF's R channel) multiplies `transmission`, or [`NO_TEXTURE`].
+    pub transmission_texture: u32,
+    /// PBR with transmission: the colour that white light has after `attenuation_distance`
+    /// inside the mesh (KHR_materials_volume, Beer–Lambert).
+    pub attenuation_color: [f32; 3],
+    /// 0 where there is no attenuation (glTF's default, +∞).
+    pub attenuation_distance: f32,
 }
+
+/// `Material::alpha_mode`: glTF's OPAQUE (alpha ignored), MASK (cut at `alpha_cutoff`) and
+/// BLEND (stochastic transparency).
+pub const ALPHA_OPAQUE: u32 = 0;
+pub const ALPHA_MASK: u32 = 1;
+pub const ALPHA_BLEND: u32 = 2;
 
 /// `Material::color_texture` and `roughness_texture` when the value is constant.
 pub const NO_TEXTURE: u32 = u32::MAX;

@@ -148,47 +148,63 @@ fn resuming_after_sigkill_gives_the_uninterrupted_image() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let spp = ["--spp", "2048"];
-    let started = Instant::now();
     let single = render_command(d, &spp)
         .args(["-o", "single.exr"])
         .output()
         .unwrap();
-    let render_time = started.elapsed();
     assert!(
         single.status.success(),
         "{}",
         String::from_utf8_lossy(&single.stderr)
     );
     let single = read(&d.join("single.exr"));
-    // Kill at moments that vary from run to run (printed, to reproduce a failure): within the
-    // first 10–60% of an uninterrupted render's time, twice, then let the last resume finish.
+    // Two kills mid-render, each one after the render has written a new checkpoint (so it made
+    // progress) and then a further 0–50 ms that vary from run to run (printed, to reproduce a
+    // failure). Waiting for a checkpoint rather than a share of a timed render keeps this true
+    // on machines of any speed and load. A render that finished before its kill is started
+    // again from nothing; the attempts are bounded.
     let nanos = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .unwrap()
         .subsec_nanos();
-    let mut killed_mid_render = false;
-    for (round, fraction) in [nanos % 1000, (nanos / 1000) % 1000]
-        .into_iter()
-        .enumerate()
-    {
-        let delay_ms = render_time.as_millis() as u64 * (100 + fraction as u64 / 2) / 1000;
+    let spp_in = |path: &Path| path.exists().then(|| read(path).accumulation.count);
+    let out_path = d.join("out.exr");
+    let mut kills_mid_render = 0;
+    for attempt in 0..8u32 {
+        if kills_mid_render == 2 {
+            break;
+        }
+        let before = spp_in(&out_path).unwrap_or(0);
         let mut command = render_command(d, &spp);
         command.args(["-o", "out.exr", "--checkpoint-interval", "0"]);
-        if d.join("out.exr").exists() {
+        if out_path.exists() {
             command.args(["--resume", "out.exr"]);
         }
         let mut child = command.spawn().unwrap();
+        wait_for(
+            "a new checkpoint or the end",
+            Duration::from_secs(120),
+            || child.try_wait().unwrap().is_some() || spp_in(&out_path).unwrap_or(0) > before,
+        );
+        let delay_ms = u64::from((nanos >> (attempt * 3)) % 51);
         std::thread::sleep(Duration::from_millis(delay_ms));
-        child.kill().unwrap(); // SIGKILL
+        child.kill().ok(); // SIGKILL; it may have exited already
         child.wait().unwrap();
-        let state = d
-            .join("out.exr")
-            .exists()
-            .then(|| read(&d.join("out.exr")).accumulation.count);
-        eprintln!("round {round}: killed after {delay_ms} ms, the file holds {state:?} spp");
-        killed_mid_render |= state.is_none_or(|n| n < 2048);
+        let state = spp_in(&out_path);
+        eprintln!(
+            "attempt {attempt}: from {before} spp, killed {delay_ms} ms after a checkpoint, \
+             the file holds {state:?} spp"
+        );
+        if state == Some(2048) {
+            std::fs::remove_file(&out_path).unwrap();
+        } else {
+            kills_mid_render += 1;
+        }
     }
-    assert!(killed_mid_render, "both renders finished before the kill");
+    assert_eq!(
+        kills_mid_render, 2,
+        "the renders kept finishing before the kill"
+    );
     let mut command = render_command(d, &spp);
     command.args(["-o", "out.exr"]);
     if d.join("out.exr").exists() {

@@ -156,7 +156,14 @@ fn rust_structs_match_wgsl_layout() {
             specular,
             emission_texture,
             normal_texture,
-            normal_scale
+            normal_scale,
+            alpha_mode,
+            opacity,
+            alpha_cutoff,
+            transmission,
+            transmission_texture,
+            attenuation_color,
+            attenuation_distance
         ]
     );
     assert_same_layout!(
@@ -222,9 +229,10 @@ fn rust_structs_match_wgsl_layout() {
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
     assert_same_layout!(&module, TriangleTangents, "TriangleTangents", [t0, t1, t2]);
-    // Five vec4s: glTF's emissive and normal textures took the fifth (a uniform-bound
-    // scene's materials stay far below the uniform limit).
-    assert_eq!(size_of::<Material>(), 80, "Material stays 80 bytes");
+    // Seven vec4s: glTF's emissive and normal textures took the fifth, alpha and transmission
+    // the sixth, volume attenuation the seventh (a uniform-bound scene's materials stay far
+    // below the uniform limit).
+    assert_eq!(size_of::<Material>(), 112, "Material stays 112 bytes");
     assert_same_layout!(
         &module,
         EnvironmentTexel,
@@ -253,14 +261,19 @@ fn material_kind_constants_match() {
             ref e => panic!("{name} is {e:?}"),
         }
     };
-    assert_eq!(
-        constant("MATERIAL_DIFFUSE"),
-        glint::shader_types::MATERIAL_DIFFUSE
-    );
-    assert_eq!(
-        constant("MATERIAL_SPECULAR"),
-        glint::shader_types::MATERIAL_SPECULAR
-    );
+    use glint::shader_types as t;
+    for (name, value) in [
+        ("MATERIAL_DIFFUSE", t::MATERIAL_DIFFUSE),
+        ("MATERIAL_SPECULAR", t::MATERIAL_SPECULAR),
+        ("MATERIAL_METAL", t::MATERIAL_METAL),
+        ("MATERIAL_DIELECTRIC", t::MATERIAL_DIELECTRIC),
+        ("MATERIAL_PBR", t::MATERIAL_PBR),
+        ("ALPHA_OPAQUE", t::ALPHA_OPAQUE),
+        ("ALPHA_MASK", t::ALPHA_MASK),
+        ("ALPHA_BLEND", t::ALPHA_BLEND),
+    ] {
+        assert_eq!(constant(name), value, "{name}");
+    }
 }
 
 /// The uniform-buffer kernel validates for any counts, empty arrays included, and declares

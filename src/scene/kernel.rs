@@ -9,9 +9,9 @@ use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleTangents, TriangleUvs, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL,
-    MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT,
-    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    TriangleTangents, TriangleUvs, ALPHA_OPAQUE, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
+    MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT,
+    PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::{Vec2, Vec3};
 
@@ -256,7 +256,13 @@ impl Scene {
                     emission_texture: m.emission_texture.unwrap_or(NO_TEXTURE),
                     normal_texture: m.normal_texture.map_or(NO_TEXTURE, |(t, _)| t),
                     normal_scale: m.normal_texture.map_or(1.0, |(_, s)| s),
-                    _pad: 0,
+                    alpha_mode: ALPHA_OPAQUE,
+                    opacity: 1.0,
+                    alpha_cutoff: 0.5,
+                    transmission: 0.0,
+                    transmission_texture: NO_TEXTURE,
+                    attenuation_color: [1.0; 3],
+                    attenuation_distance: 0.0,
                 }
             })
             .collect();
