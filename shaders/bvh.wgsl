@@ -61,7 +61,7 @@ fn hit_primitive(reference: u32, r: BvhRay) -> f32 {
     let kind = reference >> PRIMITIVE_KIND_SHIFT;
     let index = reference & PRIMITIVE_INDEX_MASK;
     if kind == PRIMITIVE_TRIANGLE {
-        return hit_triangle(triangles[index], r.tri);
+        return hit_scene_triangle(index, r.tri);
     }
     if kind == PRIMITIVE_QUAD {
         return hit_quad(quads[index], r.ray);

@@ -123,7 +123,7 @@ fn scan_closest_primitive(ray: Ray) -> ClosestPrimitive {
     if HAS_TRIANGLES && triangle_count() > 0u {
         let r = triangle_ray(ray);
         for (var i = 0u; i < triangle_count(); i++) {
-            let t = hit_triangle(triangles[i], r);
+            let t = hit_scene_triangle(i, r);
             if t < best.t {
                 best = ClosestPrimitive(t, PRIMITIVE_TRIANGLE, i);
             }

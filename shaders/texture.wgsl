@@ -7,7 +7,8 @@
 // so it would break "GPU and CPU trace the same paths". Compiled in only when a material uses
 // a texture (HAS_TEXTURES, src/shader.rs).
 
-// Every texture's descriptor, and all images' texels (linear RGB; w unused) one after another.
+// Every texture's descriptor, and all images' texels (linear RGB; w a colour texture's alpha,
+// 1 where its file has none, and unused in the others) one after another.
 @group(0) @binding(20) var<storage, read> textures: array<Texture>;
 @group(0) @binding(21) var<storage, read> texels: array<vec4<f32>>;
 // One per triangle when the scene has textures (a placeholder otherwise).
@@ -121,6 +122,21 @@ fn image_lookup(t: Texture, uv: vec2<f32>) -> vec3<f32> {
     return bottom * (1.0 - fy) + top * fy;
 }
 
+// The alpha (w) of image_lookup's texels, filtered the same way. Kept apart from image_lookup
+// so that lookups which need no alpha (every one in a scene without alpha) cost no more.
+fn image_alpha(t: Texture, uv: vec2<f32>) -> f32 {
+    let nearest = (t.sampling & TEXTURE_NEAREST) != 0u;
+    let xs = axis_texels(uv.x, t.width, t.sampling & 0xffu, nearest);
+    let ys = axis_texels(uv.y, t.height, (t.sampling >> 8u) & 0xffu, nearest);
+    let fx = xs.weight;
+    let fy = ys.weight;
+    let row0 = t.first_texel + ys.pair.x * t.width;
+    let row1 = t.first_texel + ys.pair.y * t.width;
+    let bottom = texels[row0 + xs.pair.x].w * (1.0 - fx) + texels[row0 + xs.pair.y].w * fx;
+    let top = texels[row1 + xs.pair.x].w * (1.0 - fx) + texels[row1 + xs.pair.y].w * fx;
+    return bottom * (1.0 - fy) + top * fy;
+}
+
 // color0 where floor(u scale) + floor(v scale) is even, color1 where it is odd (unfiltered).
 fn checker_lookup(t: Texture, uv: vec2<f32>) -> vec3<f32> {
     let half_sum = (floor(uv.x * t.scale) + floor(uv.y * t.scale)) * 0.5;
@@ -133,6 +149,15 @@ fn texture_lookup(index: u32, uv: vec2<f32>) -> vec3<f32> {
         return checker_lookup(t, uv);
     }
     return image_lookup(t, transformed_uv(t, uv));
+}
+
+// A colour texture's alpha at uv: its image's alpha channel; a checker is opaque.
+fn texture_alpha(index: u32, uv: vec2<f32>) -> f32 {
+    let t = textures[index];
+    if t.kind == TEXTURE_CHECKER {
+        return 1.0;
+    }
+    return image_alpha(t, transformed_uv(t, uv));
 }
 
 // The material at a hit with texture coordinates uv: textures multiply the constants (glTF's

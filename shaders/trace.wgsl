@@ -42,6 +42,11 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     let ray = (*path).ray;
     let bounce = (*path).bounce;
     let light_sampling = LIGHT_SAMPLING && params.light_sampling != 0u && emitter_count() > 0u;
+    if HAS_ALPHA {
+        // This segment's alpha decisions (alpha.wgsl): segment `bounce`, the one the ray
+        // leaving the previous vertex (or the camera) opened.
+        alpha_key = alpha_segment_key(pixel, sample, bounce);
+    }
     var hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {
@@ -99,6 +104,11 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
             let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal);
             if any(f_cos > vec3<f32>(0.0)) {
                 segments += 1u;
+                if HAS_ALPHA {
+                    // The shadow ray leaves this vertex as the next bounce's ray will: the same
+                    // segment's key, so both see the same blended triangles.
+                    alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
+                }
                 if light_visible(Ray(origin, light.dir), light) {
                     let weight = nee_weight(light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);

@@ -2,13 +2,14 @@
 
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, Material, Quad, Sphere, LIGHT_SUN, MATERIAL_DIELECTRIC, MATERIAL_METAL,
-    MATERIAL_PBR, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, LIGHT_SUN, MATERIAL_DIELECTRIC,
+    MATERIAL_METAL, MATERIAL_PBR, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    PRIMITIVE_TRIANGLE,
 };
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 26] = [
+pub const SHADER_PARTS: [(&str, &str); 27] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -39,6 +40,7 @@ pub const SHADER_PARTS: [(&str, &str); 26] = [
     ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
+    ("alpha.wgsl", include_str!("../shaders/alpha.wgsl")),
     (
         "normal_map.wgsl",
         include_str!("../shaders/normal_map.wgsl"),
@@ -266,6 +268,9 @@ pub struct KernelFeatures {
     pub lights: bool,
     /// Sun disks, which rays that escape can see (with or without light sampling).
     pub sun_disks: bool,
+    /// Alpha-tested or blended materials (shaders/alpha.wgsl): without them every triangle hit
+    /// is accepted as before, at the same cost.
+    pub alpha: bool,
 }
 
 impl KernelFeatures {
@@ -283,6 +288,7 @@ impl KernelFeatures {
         environment: true,
         lights: true,
         sun_disks: true,
+        alpha: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -306,6 +312,7 @@ impl KernelFeatures {
                 .lights
                 .iter()
                 .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
+            alpha: has_alpha(&scene.materials),
         }
     }
 
@@ -324,6 +331,7 @@ impl KernelFeatures {
             && needs(self.environment, other.environment)
             && needs(self.lights, other.lights)
             && needs(self.sun_disks, other.sun_disks)
+            && needs(self.alpha, other.alpha)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -334,7 +342,8 @@ impl KernelFeatures {
              const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
              const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
-             const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n",
+             const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
+             const HAS_ALPHA: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -346,9 +355,15 @@ impl KernelFeatures {
             self.textures,
             self.environment,
             self.lights,
-            self.sun_disks
+            self.sun_disks,
+            self.alpha
         )
     }
+}
+
+/// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`).
+pub fn has_alpha(materials: &[Material]) -> bool {
+    materials.iter().any(|m| m.alpha_mode != ALPHA_OPAQUE)
 }
 
 /// One compiled form of the kernel: where it reads the scene from, and what it compiles in.

@@ -55,6 +55,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             roughness_texture: None,
             emission_texture: None,
             normal_texture: None,
+            alpha: glint::scene::Alpha::OPAQUE,
         }],
         spheres: vec![],
         quads: vec![SceneQuad {

@@ -371,6 +371,8 @@ fn every_feature_combination_validates() {
             // Not another bit (that would double the test's time): a function of the bits that
             // meets every other feature both on and off.
             pbr: (bits.count_ones() / 2) % 2 == 1,
+            // Likewise: on in half the combinations, with and without textures and triangles.
+            alpha: (bits * 5 / 3) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -406,6 +408,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         environment: false,
         lights: false,
         sun_disks: false,
+        alpha: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

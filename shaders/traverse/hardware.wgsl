@@ -5,7 +5,9 @@
 // geometry and the spheres and quads as boxes. The hardware only proposes candidates: every
 // one, triangles included (RAY_FLAG_FORCE_NO_OPAQUE), is tested here with glint's own exact
 // test (hit_primitive, shaders/bvh.wgsl) and kept by the closest-hit rule (hit_comes_first),
-// so a hit's t and primitive are the software traversal's. No CPU mirror: the CPU traces with
+// so a hit's t and primitive are the software traversal's. That test includes alpha
+// (hit_scene_triangle, shaders/alpha.wgsl): a candidate in a hole, or that a blended triangle
+// lets through, is rejected like a miss, so no geometry needs other flags for alpha. No CPU mirror: the CPU traces with
 // the software BVH (src/cpu/bvh.rs), which this must agree with (tests/closest_hit.rs).
 
 @group(0) @binding(26) var scene_tlas: acceleration_structure;

@@ -5,8 +5,9 @@
 //! closest, and which primitives are in front, is the closest-hit rule's
 //! ([`hit_comes_first`]), whatever the order of visits.
 
+use super::alpha::hit_scene_triangle;
 use super::intersect::{hit_comes_first, hit_quad, hit_sphere, ClosestPrimitive, Geometry, NO_HIT};
-use super::triangle::{hit_triangle, triangle_ray, TriangleRay};
+use super::triangle::{triangle_ray, TriangleRay};
 use super::Ray;
 use crate::shader_types::{
     BvhNode, PRIMITIVE_ENVIRONMENT, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
@@ -82,7 +83,8 @@ pub fn hit_primitive(geometry: &Geometry, reference: u32, r: &BvhRay) -> f32 {
     let kind = reference >> PRIMITIVE_KIND_SHIFT;
     let index = (reference & PRIMITIVE_INDEX_MASK) as usize;
     if kind == PRIMITIVE_TRIANGLE {
-        return hit_triangle(&geometry.triangles[index], &r.tri);
+        let tri = &geometry.triangles[index];
+        return hit_scene_triangle(&geometry.alpha, index as u32, tri, &r.tri);
     }
     if kind == PRIMITIVE_QUAD {
         return hit_quad(&geometry.quads[index], &r.ray);

@@ -1,11 +1,12 @@
 //! Ray-scene intersection (WGSL side: `shaders/intersect.wgsl`). Ray directions are unit length.
 
+use super::alpha::{hit_scene_triangle, AlphaTest};
 use super::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
 use super::shading_normal::valid_shading_normal;
 use super::surface::{parametric_point, sphere_point};
 use super::texture::{sphere_uv, triangle_uv};
 use super::triangle::{
-    hit_triangle, triangle_barycentrics, triangle_normal, triangle_ray, triangle_surface_point,
+    triangle_barycentrics, triangle_normal, triangle_ray, triangle_surface_point,
 };
 use super::Ray;
 use crate::shader_types::{
@@ -28,6 +29,8 @@ pub struct Geometry<'a> {
     pub triangle_uvs: &'a [TriangleUvs],
     /// Whether hits need texture coordinates (the kernel's `HAS_TEXTURES`).
     pub textured: bool,
+    /// Alpha-tested and blended triangles (`alpha.rs`); off by default.
+    pub alpha: AlphaTest<'a>,
 }
 
 impl<'a> Geometry<'a> {
@@ -176,7 +179,7 @@ pub fn scan_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitiv
     if !geometry.triangles.is_empty() {
         let r = triangle_ray(ray);
         for (i, tri) in geometry.triangles.iter().enumerate() {
-            let t = hit_triangle(tri, &r);
+            let t = hit_scene_triangle(&geometry.alpha, i as u32, tri, &r);
             if t < best.t {
                 best = ClosestPrimitive {
                     t,

@@ -3,6 +3,7 @@
 //! and the fallback where there is no Vulkan device.
 
 pub mod accumulate;
+pub mod alpha;
 pub mod aov;
 pub mod bsdf;
 pub mod bvh;

@@ -22,12 +22,18 @@ pub struct Rng {
     state: u32,
 }
 
+/// The first state of the stream (pixel, sample, stream, seed).
+pub fn rng_init(pixel: u32, sample: u32, stream: u32, seed: u32) -> u32 {
+    pcg_hash(pixel.wrapping_add(pcg_hash(
+        sample.wrapping_add(pcg_hash(stream.wrapping_add(pcg_hash(seed)))),
+    )))
+}
+
 impl Rng {
     pub fn new(pixel: u32, sample: u32, stream: u32, seed: u32) -> Self {
-        let state = pcg_hash(pixel.wrapping_add(pcg_hash(
-            sample.wrapping_add(pcg_hash(stream.wrapping_add(pcg_hash(seed)))),
-        )));
-        Rng { state }
+        Rng {
+            state: rng_init(pixel, sample, stream, seed),
+        }
     }
 
     /// Uniform in [0, 1), from the top 24 bits so the conversion to f32 is exact.

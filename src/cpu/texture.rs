@@ -146,6 +146,20 @@ pub fn image_lookup(textures: &Textures, t: &Texture, uv: Vec2) -> Vec3 {
     bottom * (1.0 - fy) + top * fy
 }
 
+/// The alpha (w) of [`image_lookup`]'s texels, filtered the same way. Kept apart from
+/// `image_lookup` so that lookups which need no alpha cost no more.
+pub fn image_alpha(textures: &Textures, t: &Texture, uv: Vec2) -> f32 {
+    let nearest = t.sampling & TEXTURE_NEAREST != 0;
+    let (xs, fx) = axis_texels(uv.x, t.width, t.sampling & 0xff, nearest);
+    let (ys, fy) = axis_texels(uv.y, t.height, (t.sampling >> 8) & 0xff, nearest);
+    let row0 = t.first_texel + ys.x * t.width;
+    let row1 = t.first_texel + ys.y * t.width;
+    let w = |i: u32| textures.texels[i as usize][3];
+    let bottom = w(row0 + xs.x) * (1.0 - fx) + w(row0 + xs.y) * fx;
+    let top = w(row1 + xs.x) * (1.0 - fx) + w(row1 + xs.y) * fx;
+    bottom * (1.0 - fy) + top * fy
+}
+
 /// `color0` where ⌊u·scale⌋ + ⌊v·scale⌋ is even, `color1` where it is odd (unfiltered).
 pub fn checker_lookup(t: &Texture, uv: Vec2) -> Vec3 {
     let half_sum = ((uv.x * t.scale).floor() + (uv.y * t.scale).floor()) * 0.5;
@@ -162,6 +176,15 @@ pub fn texture_lookup(textures: &Textures, index: u32, uv: Vec2) -> Vec3 {
         return checker_lookup(t, uv);
     }
     image_lookup(textures, t, transformed_uv(t, uv))
+}
+
+/// A colour texture's alpha at `uv`: its image's alpha channel; a checker is opaque.
+pub fn texture_alpha(textures: &Textures, index: u32, uv: Vec2) -> f32 {
+    let t = &textures.descriptors[index as usize];
+    if t.kind == TEXTURE_CHECKER {
+        return 1.0;
+    }
+    image_alpha(textures, t, transformed_uv(t, uv))
 }
 
 /// The material at a hit with texture coordinates `uv`: textures multiply the constants

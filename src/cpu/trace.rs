@@ -1,6 +1,7 @@
 //! Path tracing (WGSL side: `shaders/trace.wgsl`).
 
 use super::accumulate::{accumulator_start, add_sample, merge_block};
+use super::alpha::{alpha_segment_key, AlphaTest};
 use super::aov::{
     aov_mean_add, aov_merge, aov_record_hit, aov_record_miss, aov_start, aovs_on, AovMean, PathAov,
 };
@@ -16,6 +17,7 @@ use super::surface::offset_ray_origin;
 use super::texture::{material_at, Textures};
 use super::Ray;
 use crate::scene::KernelScene;
+use crate::shader::has_alpha;
 use crate::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
     Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs, NO_TEXTURE,
@@ -24,6 +26,7 @@ use crate::shader_types::{
 use glam::Vec3;
 
 /// The scene as the kernel sees it.
+#[derive(Clone, Copy)]
 pub struct SceneRefs<'a> {
     pub params: &'a Params,
     pub spheres: &'a [Sphere],
@@ -46,6 +49,11 @@ pub struct SceneRefs<'a> {
     pub environment_alias: &'a [EnvironmentAlias],
     /// Point, spot and directional lights (`punctual.rs`).
     pub lights: &'a [Light],
+    /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
+    pub has_alpha: bool,
+    /// The key of the ray segment being traced (the kernel's private `alpha_key`), which
+    /// `path_step` sets when `has_alpha`.
+    pub alpha_key: u32,
 }
 
 impl<'a> SceneRefs<'a> {
@@ -68,6 +76,8 @@ impl<'a> SceneRefs<'a> {
             triangle_uvs: &scene.triangle_uvs,
             triangle_tangents: &scene.triangle_tangents,
             lights: &scene.lights,
+            has_alpha: has_alpha(&scene.materials),
+            alpha_key: 0,
         }
     }
 
@@ -90,6 +100,13 @@ impl<'a> SceneRefs<'a> {
             bvh_primitives: self.bvh_primitives,
             triangle_uvs: self.triangle_uvs,
             textured: !self.textures.is_empty(),
+            alpha: AlphaTest {
+                enabled: self.has_alpha,
+                materials: self.materials,
+                textures: self.textures(),
+                triangle_uvs: self.triangle_uvs,
+                key: self.alpha_key,
+            },
         }
     }
 }
@@ -150,6 +167,13 @@ pub fn path_step(
     let ray = path.ray;
     let bounce = path.bounce;
     let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
+    let mut keyed = *scene;
+    if scene.has_alpha {
+        // This segment's alpha decisions (alpha.rs): segment `bounce`, the one the ray leaving
+        // the previous vertex (or the camera) opened.
+        keyed.alpha_key = alpha_segment_key(params, pixel, sample, bounce);
+    }
+    let scene = &keyed;
     let mut hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
@@ -238,7 +262,13 @@ pub fn path_step(
                     dir: light.dir,
                 };
                 *segments += 1;
-                if light_visible(scene, &shadow, &light) {
+                let mut shadow_scene = *scene;
+                if scene.has_alpha {
+                    // The shadow ray leaves this vertex as the next bounce's ray will: the same
+                    // segment's key, so both see the same blended triangles.
+                    shadow_scene.alpha_key = alpha_segment_key(params, pixel, sample, bounce + 1);
+                }
+                if light_visible(&shadow_scene, &shadow, &light) {
                     let weight = nee_weight(&light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     let contribution =
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);

@@ -111,6 +111,12 @@ pub(super) struct MaterialToml {
     pub(super) metallic: Option<S<Real>>,
     pub(super) specular: Option<S<Real>>,
     pub(super) specular_color: Option<S<Triple>>,
+    /// Any type, on meshes: `"opaque"` (the default), `"mask"` or `"blend"` (glTF's alphaMode),
+    /// the constant `alpha` (which a colour texture's alpha multiplies) and the mask's
+    /// `alpha_cutoff`.
+    pub(super) alpha_mode: Option<S<String>>,
+    pub(super) alpha: Option<S<Real>>,
+    pub(super) alpha_cutoff: Option<S<Real>>,
 }
 
 /// `roughness = 0.3`, or anything else (`{ texture = "…" }`), which validation reads.

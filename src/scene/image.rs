@@ -35,6 +35,9 @@ pub struct LinearImage {
     pub width: u32,
     pub height: u32,
     pub texels: Vec<[f32; 3]>,
+    /// The alpha channel, one value per texel in the same order (linear: glTF's alpha is never
+    /// sRGB-encoded), or empty when the file has none (every texel opaque).
+    pub alpha: Vec<f32>,
     /// Negative values the file held, now 0.
     pub clamped: Option<ClampedNegatives>,
 }
@@ -66,6 +69,14 @@ impl ClampedNegatives {
 impl LinearImage {
     pub fn texel(&self, x: u32, y: u32) -> [f32; 3] {
         self.texels[(y * self.width + x) as usize]
+    }
+
+    /// Texel (x, y)'s alpha: 1 where the file has no alpha channel.
+    pub fn alpha(&self, x: u32, y: u32) -> f32 {
+        self.alpha
+            .get((y * self.width + x) as usize)
+            .copied()
+            .unwrap_or(1.0)
     }
 }
 
@@ -136,6 +147,13 @@ pub fn decode_linear_image(bytes: &[u8], encoding: Encoding) -> Result<LinearIma
     let decoded = reader
         .decode()
         .map_err(|e| decode_error(e, bytes, format))?;
+    // Alpha is kept for alpha-tested and blended materials (src/cpu/alpha.rs); images without
+    // it are converted without it, so they cost no more memory than before.
+    let alpha = if decoded.color().has_alpha() {
+        decoded.to_rgba32f().pixels().map(|p| p[3]).collect()
+    } else {
+        Vec::new()
+    };
     let rgb = decoded.to_rgb32f();
     // to_rgb32f maps integer texels to [0, 1] linearly; the transfer function is ours to apply.
     let decode_srgb = encoding == Encoding::Srgb && !is_float_format(format);
@@ -158,6 +176,7 @@ pub fn decode_linear_image(bytes: &[u8], encoding: Encoding) -> Result<LinearIma
         width,
         height,
         texels,
+        alpha,
         clamped,
     })
 }

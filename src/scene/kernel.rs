@@ -5,13 +5,14 @@ use super::bvh;
 use super::emitter_power::EmissionMeans;
 use super::environment;
 use super::light::LightKind;
-use super::{Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
+use super::{AlphaMode, Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleTangents, TriangleUvs, ALPHA_OPAQUE, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE,
-    MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE, PRIMITIVE_ENVIRONMENT,
-    PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    TriangleTangents, TriangleUvs, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE, MATERIAL_DIELECTRIC,
+    MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    ROULETTE_OFF,
 };
 use glam::{Vec2, Vec3};
 
@@ -133,6 +134,7 @@ impl Scene {
                 roughness_texture: None,
                 emission_texture: None,
                 normal_texture: None,
+                alpha: super::Alpha::OPAQUE,
             });
         }
         scene
@@ -256,9 +258,17 @@ impl Scene {
                     emission_texture: m.emission_texture.unwrap_or(NO_TEXTURE),
                     normal_texture: m.normal_texture.map_or(NO_TEXTURE, |(t, _)| t),
                     normal_scale: m.normal_texture.map_or(1.0, |(_, s)| s),
-                    alpha_mode: ALPHA_OPAQUE,
-                    opacity: 1.0,
-                    alpha_cutoff: 0.5,
+                    alpha_mode: match m.alpha.mode {
+                        AlphaMode::Opaque => ALPHA_OPAQUE,
+                        AlphaMode::Mask { .. } => ALPHA_MASK,
+                        AlphaMode::Blend => ALPHA_BLEND,
+                    },
+                    opacity: m.alpha.opacity,
+                    alpha_cutoff: match m.alpha.mode {
+                        AlphaMode::Mask { cutoff } => cutoff,
+                        // glTF's default, unread.
+                        AlphaMode::Opaque | AlphaMode::Blend => 0.5,
+                    },
                     transmission: 0.0,
                     transmission_texture: NO_TEXTURE,
                     attenuation_color: [1.0; 3],

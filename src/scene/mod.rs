@@ -193,6 +193,35 @@ pub struct Material {
     /// Index into [`Scene::textures`] of a tangent-space normal map (glTF's normalTexture),
     /// and the scale of its x and y.
     pub normal_texture: Option<(u32, f32)>,
+    /// glTF's alphaMode and alpha (`src/cpu/alpha.rs`); on triangles only.
+    pub alpha: Alpha,
+}
+
+/// How a material's alpha (its opacity times its colour texture's alpha) is used: glTF's
+/// alphaMode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored.
+    Opaque,
+    /// Where alpha is below `cutoff` there is no surface, for every ray.
+    Mask { cutoff: f32 },
+    /// Stochastic transparency: a ray passes with probability 1 − alpha.
+    Blend,
+}
+
+/// A material's alpha: its mode and constant opacity (glTF's baseColorFactor.a).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Alpha {
+    pub mode: AlphaMode,
+    pub opacity: f32,
+}
+
+impl Alpha {
+    /// Opaque: what every material is unless its file says otherwise.
+    pub const OPAQUE: Alpha = Alpha {
+        mode: AlphaMode::Opaque,
+        opacity: 1.0,
+    };
 }
 
 #[derive(Clone, Debug, PartialEq)]

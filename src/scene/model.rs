@@ -247,6 +247,7 @@ fn default_material_value() -> Material {
         roughness_texture: None,
         emission_texture: None,
         normal_texture: None,
+        alpha: super::Alpha::OPAQUE,
     }
 }
 

@@ -69,6 +69,7 @@ pub fn image() -> LinearImage {
         width: WIDTH,
         height: HEIGHT,
         texels,
+        alpha: Vec::new(),
         clamped: None,
     }
 }

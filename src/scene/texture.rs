@@ -53,7 +53,8 @@ pub enum TextureUse {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TextureSet {
     pub descriptors: Vec<Texture>,
-    /// Linear RGB (w unused), image after image, each bottom row first.
+    /// Linear RGB, image after image, each bottom row first; w is a colour texture's alpha
+    /// (unused in the others).
     pub texels: Vec<[f32; 4]>,
     /// Images already loaded, by canonical path and use.
     loaded: HashMap<(PathBuf, TextureUse), u32>,
@@ -126,8 +127,14 @@ impl TextureSet {
         for y in 0..image.height {
             for x in 0..image.width {
                 let texel = image.texel(x, image.height - 1 - y);
+                // A colour texture's alpha is read too (alpha-tested and blended materials).
+                let alpha = match usage {
+                    TextureUse::Color => Some(image.alpha(x, image.height - 1 - y)),
+                    _ => None,
+                };
                 if let Some(&bad) = texel[channels.clone()]
                     .iter()
+                    .chain(alpha.as_ref())
                     .find(|c| !(0.0..=1.0).contains(*c))
                 {
                     return Err(format!(
@@ -156,9 +163,11 @@ impl TextureSet {
             for x in 0..image.width {
                 let [r, g, b] = image.texel(x, y);
                 // Roughness textures as the kernel reads them: x the roughness, y the
-                // metallic factor (1 where the texture gives none).
+                // metallic factor (1 where the texture gives none). A colour texture's w is
+                // its alpha (1 where the file has none), which texture_alpha reads.
                 self.texels.push(match usage {
-                    TextureUse::Color | TextureUse::Normal => [r, g, b, 0.0],
+                    TextureUse::Color => [r, g, b, image.alpha(x, y)],
+                    TextureUse::Normal => [r, g, b, 0.0],
                     TextureUse::Roughness => [r, 1.0, 1.0, 0.0],
                     TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
                 });

@@ -19,7 +19,7 @@ use super::{
 };
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::texture::Sampling;
-use crate::scene::{Material, MaterialKind};
+use crate::scene::{Alpha, AlphaMode, Material, MaterialKind};
 use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use base64::Engine as _;
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -456,6 +456,7 @@ fn material(
         "baseColorFactor",
         Vec3::from_slice(&pbr.base_color_factor.0[..3]),
     )?;
+    let alpha = alpha(m, index)?;
     let strength = match extensions.and_then(|e| e.emissive_strength.as_ref()) {
         Some(s) => {
             let s = s.emissive_strength.0;
@@ -595,10 +596,43 @@ fn material(
             roughness_texture: None,
             emission_texture: None,
             normal_texture: None,
+            alpha,
         },
         maps,
         other_textures,
     ))
+}
+
+/// glTF's alphaMode, alphaCutoff (default 0.5) and baseColorFactor's alpha (the opacity, which
+/// the base colour texture's alpha multiplies), each checked: cutoff and opacity in [0, 1].
+fn alpha(m: &json::Material, index: usize) -> Result<Alpha, String> {
+    let field = |f: &str| format!("materials[{index}].{f}");
+    let opacity = m.pbr_metallic_roughness.base_color_factor.0[3];
+    if !(0.0..=1.0).contains(&opacity) {
+        return Err(format!(
+            "{}: its alpha (the fourth value) must be in [0, 1], got {opacity}",
+            field("pbrMetallicRoughness.baseColorFactor")
+        ));
+    }
+    let cutoff = m.alpha_cutoff.map_or(0.5, |c| c.0);
+    if !(0.0..=1.0).contains(&cutoff) {
+        return Err(format!(
+            "{}: must be in [0, 1], got {cutoff}",
+            field("alphaCutoff")
+        ));
+    }
+    let mode = match m.alpha_mode {
+        Checked::Valid(json::material::AlphaMode::Opaque) => AlphaMode::Opaque,
+        Checked::Valid(json::material::AlphaMode::Mask) => AlphaMode::Mask { cutoff },
+        Checked::Valid(json::material::AlphaMode::Blend) => AlphaMode::Blend,
+        Checked::Invalid => {
+            return Err(format!(
+                "{}: not a glTF alpha mode (\"OPAQUE\", \"MASK\" or \"BLEND\")",
+                field("alphaMode")
+            ))
+        }
+    };
+    Ok(Alpha { mode, opacity })
 }
 
 /// The images (indices into `images`) of a material's texture maps, and how each is sampled.

@@ -87,6 +87,7 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
             roughness_texture: None,
             emission_texture: None,
             normal_texture: None,
+            alpha: crate::scene::Alpha::OPAQUE,
         },
         textures,
     ))

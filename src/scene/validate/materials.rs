@@ -4,7 +4,7 @@
 use super::super::file::{MaterialToml, Real, RoughnessToml, S};
 use super::super::limits::{MAX_IOR, MIN_IOR};
 use super::super::texture::{TextureSet, TextureUse};
-use super::super::{Material, MaterialKind};
+use super::super::{Alpha, AlphaMode, Material, MaterialKind};
 use super::fields::{fail, non_negative, radiance_in_range, real, vec3, FieldError};
 use glam::Vec3;
 use std::collections::BTreeMap;
@@ -288,6 +288,7 @@ pub(super) fn validate_materials(
                 emission.as_dvec3() * strength as f64,
             )?;
         }
+        let alpha = alpha(m, &field)?;
         index_of.insert(name.clone(), materials.len() as u32);
         materials.push(Material {
             name: name.clone(),
@@ -298,6 +299,7 @@ pub(super) fn validate_materials(
             roughness_texture,
             emission_texture: None,
             normal_texture: None,
+            alpha,
         });
     }
     Ok(Materials {
@@ -305,6 +307,60 @@ pub(super) fn validate_materials(
         textures,
         index_of,
     })
+}
+
+/// `alpha_mode` (`"opaque"` unless given), `alpha` (default 1) and `alpha_cutoff` (default
+/// 0.5), each checked. The numbers apply only where the mode reads them: `alpha` to mask and
+/// blend, `alpha_cutoff` to mask; given elsewhere, they are most likely a mistake.
+fn alpha(m: &MaterialToml, field: &dyn Fn(&str) -> String) -> Result<Alpha, FieldError> {
+    let unit = |x: &S<Real>, name: &str| -> Result<f32, FieldError> {
+        let v = real(x, &field(name))?;
+        if !(0.0..=1.0).contains(&v) {
+            return fail(x.span(), field(name), format!("must be in [0, 1], got {v}"));
+        }
+        Ok(v)
+    };
+    let mode = match &m.alpha_mode {
+        None => "opaque",
+        Some(mode) => match mode.get_ref().as_str() {
+            known @ ("opaque" | "mask" | "blend") => known,
+            other => {
+                return fail(
+                    mode.span(),
+                    field("alpha_mode"),
+                    format!(
+                        "unknown alpha mode {other:?}; known modes: \"opaque\", \"mask\", \"blend\""
+                    ),
+                )
+            }
+        },
+    };
+    if let (Some(a), "opaque") = (&m.alpha, mode) {
+        return fail(
+            a.span(),
+            field("alpha"),
+            "an opaque material ignores alpha: add alpha_mode = \"mask\" or \"blend\"",
+        );
+    }
+    if let Some(c) = m.alpha_cutoff.as_ref().filter(|_| mode != "mask") {
+        return fail(
+            c.span(),
+            field("alpha_cutoff"),
+            "only alpha_mode = \"mask\" has a cutoff",
+        );
+    }
+    let opacity = m.alpha.as_ref().map_or(Ok(1.0), |a| unit(a, "alpha"))?;
+    let mode = match mode {
+        "mask" => AlphaMode::Mask {
+            cutoff: m
+                .alpha_cutoff
+                .as_ref()
+                .map_or(Ok(0.5), |c| unit(c, "alpha_cutoff"))?,
+        },
+        "blend" => AlphaMode::Blend,
+        _ => AlphaMode::Opaque,
+    };
+    Ok(Alpha { mode, opacity })
 }
 
 /// A texture as written in a material field: `{ texture = "file" }` (relative to `folder`) or

@@ -4,7 +4,7 @@ use super::super::file::{MeshToml, QuadToml, ScaleToml, SphereToml, S};
 use super::super::light::Light;
 use super::super::limits::{MIN_LENGTH, MIN_SINE};
 use super::super::mesh::{self, MeshTransform};
-use super::super::{Quad, Sphere, Triangle};
+use super::super::{AlphaMode, Material, Quad, Sphere, Triangle};
 use super::fields::{coordinates, fail, length_in_range, real, sine_between, vec3, FieldError};
 use super::materials::Materials;
 use glam::Vec3;
@@ -18,6 +18,27 @@ pub(super) struct Objects {
     /// The punctual lights of glTF files (`[[meshes]] lights`, default true).
     pub(super) lights: Vec<Light>,
     pub(super) warnings: Vec<String>,
+}
+
+/// One warning per material that is alpha-tested or blended but used by spheres or quads,
+/// which are always opaque (src/cpu/alpha.rs): alpha applies to meshes only.
+fn opaque_only_warnings(spheres: &[Sphere], quads: &[Quad], materials: &[Material]) -> Vec<String> {
+    let used = spheres
+        .iter()
+        .map(|s| s.material)
+        .chain(quads.iter().map(|q| q.material))
+        .collect::<std::collections::BTreeSet<_>>();
+    used.into_iter()
+        .map(|m| &materials[m as usize])
+        .filter(|m| m.alpha.mode != AlphaMode::Opaque)
+        .map(|m| {
+            format!(
+                "materials.{}: its alpha_mode applies to meshes only; spheres and quads that use \
+                 it are opaque",
+                m.name
+            )
+        })
+        .collect()
 }
 
 /// The scene's spheres, quads and meshes (read relative to `folder`; their own materials are
@@ -88,7 +109,7 @@ pub(super) fn validate_objects(
     }
     let mut triangles = Vec::new();
     let mut lights = Vec::new();
-    let mut warnings = Vec::new();
+    let mut warnings = opaque_only_warnings(&spheres, &quads, &materials.list);
     for (i, m) in meshes_toml.iter().enumerate() {
         let m = m.get_ref();
         let field = |f: &str| format!("meshes[{i}].{f}");
