@@ -492,3 +492,160 @@ fn an_unknown_wrap_mode_is_an_error() {
         assert!(message.contains(needle), "{message:?} lacks {needle:?}");
     }
 }
+
+/// glTF's alphaMode, alphaCutoff (default 0.5) and baseColorFactor's alpha become the
+/// material's alpha, and reach the kernel's material as its mode, opacity and cutoff.
+#[test]
+fn alpha_mode_cutoff_and_opacity_map_onto_the_material() {
+    use glint::scene::{Alpha, AlphaMode};
+    use glint::shader_types::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
+    for (material, want, kernel) in [
+        (serde_json::json!({}), Alpha::OPAQUE, (ALPHA_OPAQUE, 0.5)),
+        (
+            // OPAQUE keeps the opacity it is given; the kernel never reads it.
+            serde_json::json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.25]}}),
+            Alpha {
+                mode: AlphaMode::Opaque,
+                opacity: 0.25,
+            },
+            (ALPHA_OPAQUE, 0.5),
+        ),
+        (
+            serde_json::json!({"alphaMode": "MASK"}),
+            Alpha {
+                mode: AlphaMode::Mask { cutoff: 0.5 },
+                opacity: 1.0,
+            },
+            (ALPHA_MASK, 0.5),
+        ),
+        (
+            serde_json::json!({"alphaMode": "MASK", "alphaCutoff": 0.3,
+                "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.6]}}),
+            Alpha {
+                mode: AlphaMode::Mask { cutoff: 0.3 },
+                opacity: 0.6,
+            },
+            (ALPHA_MASK, 0.3),
+        ),
+        (
+            serde_json::json!({"alphaMode": "BLEND",
+                "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.3]}}),
+            Alpha {
+                mode: AlphaMode::Blend,
+                opacity: 0.3,
+            },
+            (ALPHA_BLEND, 0.5),
+        ),
+    ] {
+        let (json, bin) = triangle_gltf(material.clone());
+        let scene = load(&json, &bin).unwrap_or_else(|e| panic!("{e}"));
+        let index = scene.triangles[0].material as usize;
+        assert_eq!(scene.materials[index].alpha, want, "{material}");
+        let m = scene.kernel_scene().materials[index];
+        assert_eq!(
+            (m.alpha_mode, m.alpha_cutoff),
+            kernel,
+            "{material}: kernel mode and cutoff"
+        );
+        assert_eq!(m.opacity, want.opacity, "{material}: kernel opacity");
+    }
+}
+
+/// An alpha cutoff or a base colour alpha outside [0, 1], or an unknown alpha mode, is an
+/// error naming the file and the field; `glint render` exits 2 with it.
+#[test]
+fn alpha_out_of_range_is_an_error_naming_the_field() {
+    for (material, needles) in [
+        (
+            serde_json::json!({"alphaMode": "MASK", "alphaCutoff": 1.5}),
+            &["materials[0].alphaCutoff", "must be in [0, 1]", "1.5"][..],
+        ),
+        (
+            serde_json::json!({"alphaMode": "MASK", "alphaCutoff": -0.25}),
+            &["materials[0].alphaCutoff", "-0.25"][..],
+        ),
+        (
+            serde_json::json!({"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1.2]}}),
+            &[
+                "materials[0].pbrMetallicRoughness.baseColorFactor",
+                "alpha",
+                "1.2",
+            ][..],
+        ),
+        (
+            serde_json::json!({"alphaMode": "TRANSLUCENT"}),
+            &["materials[0].alphaMode", "not a glTF alpha mode"][..],
+        ),
+    ] {
+        let (json, bin) = triangle_gltf(material);
+        let message = load(&json, &bin).expect_err("the material should be refused");
+        for needle in ["scene.toml:", "meshes[0].file", "t.gltf: "]
+            .iter()
+            .chain(needles)
+        {
+            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+        }
+    }
+    let (json, bin) = triangle_gltf(serde_json::json!({"alphaMode": "MASK", "alphaCutoff": 2}));
+    let dir = write(&json, &bin);
+    let out = dir.path().join("out.png");
+    let run = common::run_render("--cpu", &dir.path().join("scene.toml"), &out);
+    common::assert_refused(&run, &out, &["t.gltf", "materials[0].alphaCutoff"]);
+}
+
+/// A 2×2 RGBA PNG with these texels, top row first.
+fn rgba_png(texels: [[u8; 4]; 4]) -> Vec<u8> {
+    let image = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba(texels[(y * 2 + x) as usize]));
+    let mut bytes = Vec::new();
+    image
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .unwrap();
+    bytes
+}
+
+/// The base colour texture's alpha is kept (linear: glTF never sRGB-encodes alpha) and the
+/// kernel's alpha at each texel centre is baseColorFactor.a × the texel's alpha, where the
+/// colour is sRGB-decoded as before. An RGB texture's alpha is 1.
+#[test]
+fn the_base_color_textures_alpha_is_kept_linear() {
+    use glint::cpu::texture::{texture_alpha, Textures};
+    let texels = [
+        [255, 0, 0, 0],
+        [0, 255, 0, 64],
+        [0, 0, 255, 128],
+        [9, 9, 9, 255],
+    ];
+    for (image, alphas) in [
+        (rgba_png(texels), texels.map(|t| t[3] as f32 / 255.0)),
+        (png(COLOR_TEXELS), [1.0; 4]),
+    ] {
+        let material = serde_json::json!({"alphaMode": "BLEND", "pbrMetallicRoughness": {
+            "baseColorFactor": [1.0, 1.0, 1.0, 0.5],
+            "baseColorTexture": {"index": 0}
+        }});
+        let bytes = glb(material, &[image], |g| {
+            g["textures"] = serde_json::json!([{"source": 0}]);
+        });
+        let scene = load_glb(&bytes).unwrap_or_else(|e| panic!("{e}"));
+        let index = scene.triangles[0].material as usize;
+        let scene = scene.kernel_scene();
+        let m = scene.materials[index];
+        let textures = Textures {
+            descriptors: &scene.textures,
+            texels: &scene.texels,
+        };
+        for (i, want) in alphas.iter().enumerate() {
+            let (x, y) = ((i % 2) as f32, (i / 2) as f32);
+            let uv = glam::Vec2::new((x + 0.5) / 2.0, 1.0 - (y + 0.5) / 2.0);
+            let got = m.opacity * texture_alpha(&textures, m.color_texture, uv);
+            assert!(
+                (got - 0.5 * want).abs() < 1e-6,
+                "texel {i}: alpha {got}, want {}",
+                0.5 * want
+            );
+        }
+    }
+}

@@ -394,3 +394,74 @@ fn new_material_and_camera_fields() {
         &["TOML"],
     );
 }
+
+/// `alpha_mode`, `alpha` and `alpha_cutoff`: read where they apply, and each mistake an error
+/// naming the field, at its line.
+#[test]
+fn alpha_fields_are_read_and_checked() {
+    use glint::scene::{Alpha, AlphaMode};
+    let white = "color = [0.7, 0.7, 0.7]";
+    let with = |lines: &str| edited(white, &format!("{white}\n{lines}"));
+    let alpha_of = |text: &str| {
+        let scene = parse(text).unwrap_or_else(|e| panic!("{e}"));
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == "white")
+            .unwrap()
+            .alpha
+    };
+    assert_eq!(alpha_of(GOOD), Alpha::OPAQUE);
+    assert_eq!(
+        alpha_of(&with(
+            "alpha_mode = \"mask\"\nalpha = 0.8\nalpha_cutoff = 0.25"
+        )),
+        Alpha {
+            mode: AlphaMode::Mask { cutoff: 0.25 },
+            opacity: 0.8
+        }
+    );
+    assert_eq!(
+        alpha_of(&with("alpha_mode = \"mask\"")),
+        Alpha {
+            mode: AlphaMode::Mask { cutoff: 0.5 },
+            opacity: 1.0
+        }
+    );
+    assert_eq!(
+        alpha_of(&with("alpha_mode = \"blend\"\nalpha = 0.3")),
+        Alpha {
+            mode: AlphaMode::Blend,
+            opacity: 0.3
+        }
+    );
+    assert_error(
+        &with("alpha_mode = \"translucent\""),
+        Some(16),
+        &[
+            "materials.white.alpha_mode",
+            "unknown alpha mode \"translucent\"",
+            "\"blend\"",
+        ],
+    );
+    assert_error(
+        &with("alpha_mode = \"blend\"\nalpha = 1.5"),
+        Some(17),
+        &["materials.white.alpha", "must be in [0, 1]", "1.5"],
+    );
+    assert_error(
+        &with("alpha = 0.5"),
+        Some(16),
+        &["materials.white.alpha", "opaque material ignores alpha"],
+    );
+    assert_error(
+        &with("alpha_mode = \"blend\"\nalpha_cutoff = 0.3"),
+        Some(17),
+        &["materials.white.alpha_cutoff", "only alpha_mode = \"mask\""],
+    );
+    assert_error(
+        &with("alpha_mode = \"mask\"\nalpha_cutoff = -1"),
+        Some(17),
+        &["materials.white.alpha_cutoff", "must be in [0, 1]", "-1"],
+    );
+}
