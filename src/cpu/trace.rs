@@ -89,6 +89,14 @@ impl<'a> SceneRefs<'a> {
         }
     }
 
+    /// The same scene tracing the ray segment whose alpha key is `key`.
+    pub fn with_alpha_key(&self, key: u32) -> SceneRefs<'a> {
+        SceneRefs {
+            alpha_key: key,
+            ..*self
+        }
+    }
+
     /// What intersection reads.
     pub fn geometry(&self) -> Geometry<'a> {
         Geometry {
@@ -167,13 +175,15 @@ pub fn path_step(
     let ray = path.ray;
     let bounce = path.bounce;
     let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
-    let mut keyed = *scene;
-    if scene.has_alpha {
-        // This segment's alpha decisions (alpha.rs): segment `bounce`, the one the ray leaving
-        // the previous vertex (or the camera) opened.
-        keyed.alpha_key = alpha_segment_key(params, pixel, sample, bounce);
-    }
-    let scene = &keyed;
+    // This segment's alpha decisions (alpha.rs): segment `bounce`, the one the ray leaving the
+    // previous vertex (or the camera) opened. A copy only where alpha is read at all.
+    let keyed;
+    let scene = if scene.has_alpha {
+        keyed = scene.with_alpha_key(alpha_segment_key(params, pixel, sample, bounce));
+        &keyed
+    } else {
+        scene
+    };
     let mut hit = intersect_scene(&scene.geometry(), &ray);
     *segments += 1;
     if hit.t == NO_HIT {
@@ -262,13 +272,17 @@ pub fn path_step(
                     dir: light.dir,
                 };
                 *segments += 1;
-                let mut shadow_scene = *scene;
-                if scene.has_alpha {
-                    // The shadow ray leaves this vertex as the next bounce's ray will: the same
-                    // segment's key, so both see the same blended triangles.
-                    shadow_scene.alpha_key = alpha_segment_key(params, pixel, sample, bounce + 1);
-                }
-                if light_visible(&shadow_scene, &shadow, &light) {
+                // The shadow ray leaves this vertex as the next bounce's ray will: the same
+                // segment's key, so both see the same blended triangles.
+                let keyed;
+                let shadow_scene = if scene.has_alpha {
+                    let key = alpha_segment_key(params, pixel, sample, bounce + 1);
+                    keyed = scene.with_alpha_key(key);
+                    &keyed
+                } else {
+                    scene
+                };
+                if light_visible(shadow_scene, &shadow, &light) {
                     let weight = nee_weight(&light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
                     let contribution =
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);

@@ -395,7 +395,8 @@ fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
 /// defaults), KHR_materials_ior and KHR_materials_specular's factors → `pbr`;
 /// KHR_materials_transmission > 0 → dielectric with the ior (glint has no rough or partly
 /// transmissive dielectric yet: a warning says so); emissiveFactor ×
-/// KHR_materials_emissive_strength → emission. Warning lines go to `warnings`.
+/// KHR_materials_emissive_strength → emission; alphaMode, alphaCutoff and baseColorFactor's
+/// alpha → alpha. Warning lines go to `warnings`.
 fn material(
     root: &json::Root,
     m: &json::Material,
