@@ -295,7 +295,8 @@ fn blend_lets_seven_tenths_of_shadow_rays_through() {
 
 /// A scene with both modes and light bouncing between them: a masked square (textured) and a
 /// blended one (α = 0.4, textured: its alpha times the texture's) over a floor, lit by a
-/// quad emitter and a directional light, 4 bounces, seen at an angle.
+/// quad emitter, a directional light and a point light (the three kinds of shadow test:
+/// first_hit_is, escapes and a bounded search), 4 bounces, seen at an angle.
 fn mixed_scene(dir: &Path, seed: u32) -> KernelScene {
     alpha_png(&dir.join("alpha.png"));
     square_obj(
@@ -324,7 +325,8 @@ fn mixed_scene(dir: &Path, seed: u32) -> KernelScene {
          [[quads]]\ncorner = [-0.5, 3.0, -0.5]\nu = [1.0, 0.0, 0.0]\nv = [0.0, 0.0, 1.0]\nmaterial = \"lamp\"\n\n\
          [[meshes]]\nfile = \"mask.obj\"\nmaterial = \"mask\"\n\n\
          [[meshes]]\nfile = \"blend.obj\"\nmaterial = \"blend\"\n\n\
-         [[lights]]\ntype = \"directional\"\ndirection = [0.3, -1.0, -0.2]\nintensity = 1.5\n"
+         [[lights]]\ntype = \"directional\"\ndirection = [0.3, -1.0, -0.2]\nintensity = 1.5\n\n\
+         [[lights]]\ntype = \"point\"\nposition = [0.2, 2.2, -0.4]\nintensity = 2.0\n"
     );
     load(dir, &text)
 }
