@@ -47,6 +47,8 @@ pub enum TextureUse {
     MetallicRoughness,
     /// A tangent-space normal map (glTF's normalTexture): linear, every channel in [0, 1].
     Normal,
+    /// glTF's transmissionTexture: linear, the first (red) channel in [0, 1].
+    Transmission,
 }
 
 /// Every texture of a scene, as the kernel reads them.
@@ -119,7 +121,7 @@ impl TextureSet {
         // The channels the use reads.
         let channels = match usage {
             TextureUse::Color | TextureUse::Normal => 0..3,
-            TextureUse::Roughness => 0..1,
+            TextureUse::Roughness | TextureUse::Transmission => 0..1,
             TextureUse::MetallicRoughness => 1..3,
         };
         // Rows from the top (as files store them) to rows from the bottom.
@@ -139,6 +141,7 @@ impl TextureSet {
                             TextureUse::Roughness => "roughness",
                             TextureUse::MetallicRoughness => "metallic-roughness",
                             TextureUse::Normal => "normal",
+                            TextureUse::Transmission => "transmission",
                         }
                     ));
                 }
@@ -159,7 +162,7 @@ impl TextureSet {
                 // metallic factor (1 where the texture gives none).
                 self.texels.push(match usage {
                     TextureUse::Color | TextureUse::Normal => [r, g, b, 0.0],
-                    TextureUse::Roughness => [r, 1.0, 1.0, 0.0],
+                    TextureUse::Roughness | TextureUse::Transmission => [r, 1.0, 1.0, 0.0],
                     TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
                 });
             }
@@ -211,8 +214,9 @@ impl TextureSet {
 fn encoding(usage: TextureUse) -> Encoding {
     match usage {
         TextureUse::Color => Encoding::Srgb,
-        TextureUse::Roughness | TextureUse::MetallicRoughness | TextureUse::Normal => {
-            Encoding::Linear
-        }
+        TextureUse::Roughness
+        | TextureUse::MetallicRoughness
+        | TextureUse::Normal
+        | TextureUse::Transmission => Encoding::Linear,
     }
 }

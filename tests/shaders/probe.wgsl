@@ -118,14 +118,14 @@ fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // The material at a hit: material probe.seed of the bound scene at the texture coordinates of
 // triangle_uvs[id / 2].uv0 (tests/gltf_materials.rs fills them); even entries write albedo
-// and alpha, odd ones metallic.
+// and alpha, odd ones metallic and transmission.
 @compute @workgroup_size(256, 1, 1)
 fn probe_material_at(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
     let m = material_at(materials[probe.seed], triangle_uv(id.x / 2u, vec3<f32>(1.0, 0.0, 0.0)));
-    probe_out[id.x] = select(vec4<f32>(m.metallic, 0.0, 0.0, 0.0), vec4<f32>(m.albedo, m.alpha), id.x % 2u == 0u);
+    probe_out[id.x] = select(vec4<f32>(m.metallic, m.transmission, 0.0, 0.0), vec4<f32>(m.albedo, m.alpha), id.x % 2u == 0u);
 }
 
 // The emitter choice alone (pick_emitter, from the draws sample_light makes first): the

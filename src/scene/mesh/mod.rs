@@ -20,7 +20,7 @@ pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{Sampling, TextureSet, TextureUse};
-use super::{Material, Triangle};
+use super::{Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -130,6 +130,9 @@ pub(super) struct FileTextures {
     metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `emissiveTexture` (sRGB), multiplying the emission.
     emission: Option<(Rc<ImageSource>, Sampling)>,
+    /// KHR_materials_transmission's `transmissionTexture` (linear): red multiplies the
+    /// transmission factor.
+    transmission: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `normalTexture` (linear), and its scale.
     normal: Option<((Rc<ImageSource>, Sampling), f32)>,
 }
@@ -251,6 +254,14 @@ pub(crate) fn load(
                         m.roughness_texture =
                             load(&maps.metallic_roughness, TextureUse::MetallicRoughness)?;
                         m.emission_texture = load(&maps.emission, TextureUse::Color)?;
+                        if let MaterialKind::Pbr {
+                            transmission_texture,
+                            ..
+                        } = &mut m.kind
+                        {
+                            *transmission_texture =
+                                load(&maps.transmission, TextureUse::Transmission)?;
+                        }
                         if let Some((map, scale)) = &maps.normal {
                             m.normal_texture =
                                 load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
