@@ -1218,76 +1218,130 @@ fn cpu_rough_dielectric_sampling() {
     }
 }
 
-/// The pbr material with transmission (1, and 0.5 over a diffuse base): a mixture of the
-/// specular lobe, the cosine lobe and the rough dielectric with the probabilities
-/// `pbr_lobes` reports, light entering and leaving. Kept samples' density is
-/// p_s D_vis + p_c cos/π above the surface, plus p_t times the rough dielectric's (references
-/// above); the rest are absorbed.
-#[test]
-fn cpu_pbr_transmission_sampling() {
-    let n = Vec3::new(0.2, 0.9, -0.3).normalize();
-    let (t, _) = n.any_orthonormal_pair();
-    let wo = 0.5 * n + 0.75f32.sqrt() * t;
-    let mut k = 0;
+/// (transmission, GGX α, entering) of the pbr transmission tests: the rough dielectric alone
+/// (transmission 1) and half of it over the diffuse stack, at roughness 0.3 and 0.8.
+fn pbr_transmission_cases() -> Vec<(f32, f32, bool)> {
+    let mut cases = Vec::new();
     for transmission in [1.0f32, 0.5] {
         for alpha in [0.09f32, 0.64] {
             for entering in [true, false] {
-                k += 1;
-                let m = glint::shader_types::Material {
-                    albedo: [0.8, 0.5, 0.3],
-                    kind: glint::shader_types::MATERIAL_PBR,
-                    alpha,
-                    ior: GLASS_IOR,
-                    metallic: 0.0,
-                    specular: 1.0,
-                    specular_color: [1.0; 3],
-                    transmission,
-                    ..Default::default()
-                };
-                let lobes = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n), entering);
-                let p_s = lobes.specular_probability() as f64;
-                let p_t = lobes.transmission_probability() as f64;
-                if transmission == 1.0 {
-                    assert_eq!(p_t, 1.0, "transmission 1 samples only the rough dielectric");
-                }
-                let (eta_o, eta_i) = if entering {
-                    (1.0, GLASS_IOR as f64)
-                } else {
-                    (GLASS_IOR as f64, 1.0)
-                };
-                let samples: Vec<(Vec3, bool)> = (0..SAMPLES)
-                    .map(|i| {
-                        let mut r = cpu_draws(i, SEED + 151 + k);
-                        let s = glint::cpu::material::bsdf_sample(&m, wo, n, entering, &mut r);
-                        let kept = s.weight != Vec3::ZERO;
-                        if kept {
-                            // Refraction is marked delta (light sampling cannot reach it).
-                            assert_eq!(s.is_delta, s.dir.dot(n) < 0.0, "is_delta at {}", s.dir);
-                        }
-                        (s.dir, kept)
-                    })
-                    .collect();
-                let (kept, absorbed) = split_absorbed(&samples);
-                let pdf = |d: Vec3| {
-                    let d = d.as_dvec3().normalize();
-                    let (wo, n) = (wo.as_dvec3(), n.as_dvec3());
-                    let cos = d.dot(n);
-                    let mut p =
-                        p_t * reference_rough_dielectric_pdf(wo, d, n, alpha as f64, eta_o, eta_i);
-                    if cos > 0.0 {
-                        p += p_s * reference_ggx_pdf(wo, d, n, alpha as f64)
-                            + (1.0 - p_s - p_t) * cos / PI;
-                    }
-                    p
-                };
-                assert_fits(
-                    &format!(
-                        "cpu pbr, transmission {transmission}, α {alpha}, {}",
-                        if entering { "entering" } else { "leaving" }
-                    ),
-                    &directions_with_absorbed(&kept, absorbed, n, pdf, 20, 40, 48),
-                );
+                cases.push((transmission, alpha, entering));
             }
         }
+    }
+    cases
+}
+
+/// The pbr transmission tests' normal and wo (60° from it).
+fn pbr_transmission_geometry() -> (Vec3, Vec3) {
+    let n = Vec3::new(0.2, 0.9, -0.3).normalize();
+    let (t, _) = n.any_orthonormal_pair();
+    (n, 0.5 * n + 0.75f32.sqrt() * t)
+}
+
+fn pbr_glass(albedo: [f32; 3], alpha: f32, transmission: f32) -> glint::shader_types::Material {
+    glint::shader_types::Material {
+        albedo,
+        kind: glint::shader_types::MATERIAL_PBR,
+        alpha,
+        ior: GLASS_IOR,
+        metallic: 0.0,
+        specular: 1.0,
+        specular_color: [1.0; 3],
+        transmission,
+        ..Default::default()
+    }
+}
+
+/// The pbr material with transmission: a mixture of the specular lobe, the cosine lobe and
+/// the rough dielectric with the probabilities `pbr_lobes` reports (which the CPU's material
+/// `m` gives; the GPU's is the same). Kept samples' density is p_s D_vis + p_c cos/π above
+/// the surface, plus p_t times the rough dielectric's (references above); the rest
+/// (reflections below the surface, refractions above it) are absorbed.
+fn check_pbr_transmission_samples(
+    name: &str,
+    m: &glint::shader_types::Material,
+    entering: bool,
+    samples: &[(Vec3, bool)],
+) {
+    let (n, wo) = pbr_transmission_geometry();
+    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), entering);
+    let p_s = lobes.specular_probability() as f64;
+    let p_t = lobes.transmission_probability() as f64;
+    if m.transmission == 1.0 {
+        assert_eq!(p_t, 1.0, "transmission 1 samples only the rough dielectric");
+    }
+    let (eta_o, eta_i) = if entering {
+        (1.0, GLASS_IOR as f64)
+    } else {
+        (GLASS_IOR as f64, 1.0)
+    };
+    let (kept, absorbed) = split_absorbed(samples);
+    let alpha = m.alpha as f64;
+    let pdf = |d: Vec3| {
+        let d = d.as_dvec3().normalize();
+        let (wo, n) = (wo.as_dvec3(), n.as_dvec3());
+        let cos = d.dot(n);
+        let mut p = p_t * reference_rough_dielectric_pdf(wo, d, n, alpha, eta_o, eta_i);
+        if cos > 0.0 {
+            p += p_s * reference_ggx_pdf(wo, d, n, alpha) + (1.0 - p_s - p_t) * cos / PI;
+        }
+        p
+    };
+    assert_fits(
+        name,
+        &directions_with_absorbed(&kept, absorbed, n, pdf, 20, 40, 48),
+    );
+}
+
+fn pbr_transmission_name(device: &str, transmission: f32, alpha: f32, entering: bool) -> String {
+    let side = if entering { "entering" } else { "leaving" };
+    format!("{device} pbr, transmission {transmission}, α {alpha}, {side}")
+}
+
+#[test]
+fn cpu_pbr_transmission_sampling() {
+    let (n, wo) = pbr_transmission_geometry();
+    for (k, (transmission, alpha, entering)) in pbr_transmission_cases().into_iter().enumerate() {
+        let m = pbr_glass([0.8, 0.5, 0.3], alpha, transmission);
+        let samples: Vec<(Vec3, bool)> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 151 + k as u32);
+                let s = glint::cpu::material::bsdf_sample(&m, wo, n, entering, &mut r);
+                let kept = s.weight != Vec3::ZERO;
+                if kept {
+                    // Refraction is marked delta (light sampling cannot reach it).
+                    assert_eq!(s.is_delta, s.dir.dot(n) < 0.0, "is_delta at {}", s.dir);
+                }
+                (s.dir, kept)
+            })
+            .collect();
+        let name = pbr_transmission_name("cpu", transmission, alpha, entering);
+        check_pbr_transmission_samples(&name, &m, entering, &samples);
+    }
+}
+
+/// The WGSL sampler (tests/shaders/probe.wgsl's probe_pbr: a white base) against the same
+/// reference.
+#[test]
+fn gpu_pbr_transmission_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    let (n, wo) = pbr_transmission_geometry();
+    for (k, (transmission, alpha, entering)) in pbr_transmission_cases().into_iter().enumerate() {
+        let m = pbr_glass([1.0; 3], alpha, transmission);
+        let params = ProbeParams {
+            wo: wo.into(),
+            alpha,
+            ior: GLASS_IOR,
+            front_face: entering as u32,
+            transmission,
+            ..probe(n, SAMPLES, SEED + 171 + k as u32)
+        };
+        let samples: Vec<(Vec3, bool)> = run_probe(ctx, "probe_pbr", params, &empty_scene())
+            .iter()
+            .map(|s| (Vec3::new(s[0], s[1], s[2]), s[3] != 0.0))
+            .collect();
+        let name = pbr_transmission_name("gpu", transmission, alpha, entering);
+        check_pbr_transmission_samples(&name, &m, entering, &samples);
     }
 }

@@ -13,6 +13,8 @@ struct ProbeParams {
     side_probe: vec3<f32>,
     ior: f32,
     front_face: u32,
+    // The pbr material's transmission (probe_pbr).
+    transmission: f32,
 }
 
 @group(0) @binding(10) var<uniform> probe: ProbeParams;
@@ -67,6 +69,21 @@ fn probe_metal(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var rng = rng_init(id.x, 0u, 1u, probe.seed);
     let s = bsdf_sample(probe_material(MATERIAL_METAL), probe.wo, probe.normal, true, &rng);
+    probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
+}
+
+// A white dielectric pbr material (metallic 0, specular 1) with probe.transmission.
+@compute @workgroup_size(256, 1, 1)
+fn probe_pbr(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var m = probe_material(MATERIAL_PBR);
+    m.specular = 1.0;
+    m.specular_color = vec3<f32>(1.0);
+    m.transmission = probe.transmission;
+    let s = bsdf_sample(m, probe.wo, probe.normal, probe.front_face != 0u, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
 
