@@ -116,6 +116,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
                 Some((image, scale)) => source(Some(image))?.map(|s| (s, scale)),
                 None => None,
             },
+            roughness_and_metallic: None,
         });
         materials.push(material);
         has_other_textures |= other_textures;

@@ -135,6 +135,8 @@ pub(super) struct FileTextures {
     transmission: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `normalTexture` (linear), and its scale.
     normal: Option<((Rc<ImageSource>, Sampling), f32)>,
+    /// OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, merged on load.
+    roughness_and_metallic: Option<(Option<PathBuf>, Option<PathBuf>)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -265,6 +267,16 @@ pub(crate) fn load(
                         if let Some((map, scale)) = &maps.normal {
                             m.normal_texture =
                                 load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
+                        }
+                        if let Some((roughness, metallic)) = &maps.roughness_and_metallic {
+                            m.roughness_texture = Some(
+                                textures
+                                    .roughness_and_metallic(
+                                        roughness.as_deref(),
+                                        metallic.as_deref(),
+                                    )
+                                    .map_err(|e| format!("material {name:?}: {e}"))?,
+                            );
                         }
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;
