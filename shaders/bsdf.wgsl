@@ -6,5 +6,7 @@ struct BsdfSample {
     weight: vec3<f32>,
     // Solid-angle pdf of dir; 0 for delta lobes.
     pdf: f32,
+    // Light sampling cannot find dir, so what the ray reaches counts in full: delta lobes, and
+    // refraction (shadow rays do not pass through surfaces).
     is_delta: bool,
 }

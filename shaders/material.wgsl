@@ -1,5 +1,6 @@
 // The BSDF of each material kind, dispatched to its lobes (mirror: src/cpu/material.rs):
-// diffuse.wgsl, conductor.wgsl, dielectric.wgsl, pbr.wgsl, on microfacet.wgsl and frame.wgsl.
+// diffuse.wgsl, conductor.wgsl, dielectric.wgsl, pbr.wgsl (with rough_dielectric.wgsl), on
+// microfacet.wgsl and frame.wgsl.
 
 // Material kinds a scene lacks are compiled out (HAS_*, see src/shader.rs).
 fn is_metal(m: Material) -> bool {
@@ -21,15 +22,16 @@ fn is_delta(m: Material) -> bool {
         || (is_metal(m) && m.alpha < MIN_METAL_ALPHA);
 }
 
-// f * cos(theta_i) for light arriving from wi and leaving towards wo (n faces wo). Zero for delta
-// lobes and for wi below the surface.
-fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// f * cos(theta_i) for light arriving from wi and leaving towards wo (n faces wo; front_face says
+// whether that is the outside). Zero for delta lobes and for wi below the surface (light
+// sampling's shadow rays do not pass through surfaces).
+fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, front_face: bool) -> vec3<f32> {
     let cos_i = dot(wi, n);
     if cos_i <= 0.0 || is_delta(m) {
         return vec3<f32>(0.0);
     }
     if is_pbr(m) {
-        return pbr_eval(pbr_lobes(m, dot(wo, n)), to_local(wo, n), to_local(wi, n));
+        return pbr_eval(pbr_lobes(m, dot(wo, n), front_face), to_local(wo, n), to_local(wi, n));
     }
     if is_metal(m) {
         return conductor_eval(m.albedo, m.alpha, to_local(wo, n), to_local(wi, n));
@@ -38,12 +40,12 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> vec3<f3
 }
 
 // The solid-angle pdf with which bsdf_sample returns wi.
-fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> f32 {
+fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, front_face: bool) -> f32 {
     if is_delta(m) {
         return 0.0;
     }
     if is_pbr(m) {
-        return pbr_pdf(pbr_lobes(m, dot(wo, n)), to_local(wo, n), to_local(wi, n));
+        return pbr_pdf(pbr_lobes(m, dot(wo, n), front_face), to_local(wo, n), to_local(wi, n));
     }
     if is_metal(m) {
         return ggx_reflection_pdf(to_local(wo, n), to_local(wi, n), m.alpha);
@@ -52,7 +54,7 @@ fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>) -> f32 {
 }
 
 // Samples the direction light arrives from, for light leaving towards wo. `n` faces wo;
-// `front_face` says whether that is the outside (for glass).
+// `front_face` says whether that is the outside (for glass and transmission).
 fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: ptr<function, u32>) -> BsdfSample {
     if m.kind == MATERIAL_SPECULAR {
         var out: BsdfSample;
@@ -67,7 +69,7 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: 
     }
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     if is_pbr(m) {
-        return pbr_sample(pbr_lobes(m, dot(wo, n)), wo, n, rng_next(rng), u);
+        return pbr_sample(pbr_lobes(m, dot(wo, n), front_face), wo, n, rng_next(rng), u);
     }
     if is_metal(m) {
         return conductor_sample(m.albedo, m.alpha, wo, n, u);

@@ -1,7 +1,10 @@
 // glTF 2.0's metallic-roughness material, energy-compensated (mirror: src/cpu/pbr.rs, which
 // says how): a GGX specular lobe with Schlick's Fresnel mixed between the dielectric layer's
 // and the metal's, Kulla and Conty's multiple-scattering lobe, and the diffuse base under the
-// dielectric layer by reciprocal albedo scaling.
+// dielectric layer by reciprocal albedo scaling; with transmission T, (1 - T) of that stack and T
+// of rough_dielectric.wgsl's rough glass, its refraction tinted by the base colour. Refracted
+// samples are marked delta: shadow rays do not pass through surfaces, so what they reach counts
+// in full.
 
 // The smallest GGX alpha of the material (roughness 0.032).
 const PBR_MIN_ALPHA: f32 = 1e-3;
@@ -20,7 +23,11 @@ struct PbrLobes {
     ms_metal: vec3<f32>,
     layer_o: vec3<f32>,
     layer_average: vec3<f32>,
+    // The transmissive share of the dielectric part, and eta(other side) / eta(wo's side).
+    transmission: f32,
+    etap: f32,
     specular_probability: f32,
+    transmission_probability: f32,
 }
 
 fn channel_average(v: vec3<f32>) -> f32 {
@@ -32,7 +39,8 @@ fn multiple_scattering_fresnel(f_average: vec3<f32>, e_average: f32) -> vec3<f32
     return f_average * f_average * e_average / (vec3<f32>(1.0) - f_average * (1.0 - e_average));
 }
 
-fn pbr_lobes(m: Material, mu_o: f32) -> PbrLobes {
+// front_face says whether wo is on the outside (which decides eta for transmission).
+fn pbr_lobes(m: Material, mu_o: f32, front_face: bool) -> PbrLobes {
     var l: PbrLobes;
     l.base = m.albedo;
     l.alpha = max(m.alpha, PBR_MIN_ALPHA);
@@ -53,54 +61,87 @@ fn pbr_lobes(m: Material, mu_o: f32) -> PbrLobes {
         + vec3<f32>(l.dielectric_f90 * ab_average.y)
         + l.ms_dielectric * (1.0 - l.e_average);
     l.metallic = m.metallic;
-    let specular = (1.0 - l.metallic) * (l.dielectric_f0 * ab_o.x + vec3<f32>(l.dielectric_f90 * ab_o.y))
+    l.transmission = select(0.0, m.transmission, HAS_TRANSMISSION);
+    l.etap = select(1.0 / m.ior, m.ior, front_face);
+    // The opaque dielectric stack's share.
+    let opaque = (1.0 - l.metallic) * (1.0 - l.transmission);
+    let specular = opaque * (l.dielectric_f0 * ab_o.x + vec3<f32>(l.dielectric_f90 * ab_o.y))
         + l.metallic * (l.base * ab_o.x + vec3<f32>(ab_o.y));
-    let ms = ((1.0 - l.metallic) * l.ms_dielectric + l.metallic * l.ms_metal) * (1.0 - l.e_o);
-    let diffuse = (1.0 - l.metallic) * l.base * (vec3<f32>(1.0) - l.layer_o);
+    let ms = (opaque * l.ms_dielectric + l.metallic * l.ms_metal) * (1.0 - l.e_o);
+    let diffuse = opaque * l.base * (vec3<f32>(1.0) - l.layer_o);
     let specular_weight = channel_average(specular);
     let other_weight = channel_average(ms + diffuse);
-    let total = specular_weight + other_weight;
-    l.specular_probability = 0.5;
+    let transmission_weight = (1.0 - l.metallic) * l.transmission;
+    let opaque_total = specular_weight + other_weight;
+    let total = opaque_total + transmission_weight;
+    l.transmission_probability = 0.0;
     if total > 0.0 {
-        l.specular_probability = clamp(specular_weight / total, MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY);
+        l.transmission_probability = transmission_weight / total;
     }
+    var specular_share = 0.5;
+    if opaque_total > 0.0 {
+        specular_share = clamp(specular_weight / opaque_total, MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY);
+    }
+    l.specular_probability = (1.0 - l.transmission_probability) * specular_share;
     return l;
 }
 
 // f * cos(theta_i); wo and wi in the local frame.
 fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
+    // The transmission lobe's share of the whole.
+    let transmissive = (1.0 - l.metallic) * l.transmission;
+    if wo.z <= 0.0 || wi.z == 0.0 {
         return vec3<f32>(0.0);
     }
+    if wi.z < 0.0 {
+        if !HAS_TRANSMISSION || transmissive <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        return l.base * (transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+    }
+    let opaque = (1.0 - l.metallic) * (1.0 - l.transmission);
     let h = normalize(wo + wi);
     let c = clamp(1.0 - dot(wo, h), 0.0, 1.0);
     let s5 = c * c * c * c * c;
     let f_dielectric = l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * s5;
     let f_metal = l.base + (vec3<f32>(1.0) - l.base) * s5;
-    let fresnel = (1.0 - l.metallic) * f_dielectric + l.metallic * f_metal;
+    let fresnel = opaque * f_dielectric + l.metallic * f_metal;
     let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
     let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
     let ab_i = ggx_albedo(wi.z, l.alpha);
     let e_i = ab_i.x + ab_i.y;
     var out = specular;
     if l.e_average < 1.0 {
-        let ms = (1.0 - l.metallic) * l.ms_dielectric + l.metallic * l.ms_metal;
+        let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
         out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
     }
     let layer_i = l.dielectric_f0 * ab_i.x + vec3<f32>(l.dielectric_f90 * ab_i.y) + l.ms_dielectric * (1.0 - e_i);
     let transmitted = (vec3<f32>(1.0) - l.layer_o) * (vec3<f32>(1.0) - layer_i);
     let room = vec3<f32>(1.0) - l.layer_average;
     let base_weight = select(vec3<f32>(0.0), transmitted / room, room > vec3<f32>(0.0));
-    return out + (1.0 - l.metallic) * l.base * base_weight * (wi.z / PI);
+    out += opaque * l.base * base_weight * (wi.z / PI);
+    if HAS_TRANSMISSION && transmissive > 0.0 {
+        out += vec3<f32>(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+    }
+    return out;
 }
 
 // The mixture pdf of pbr_sample; wo and wi in the local frame.
 fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
+    if wo.z <= 0.0 {
         return 0.0;
     }
-    let p = l.specular_probability;
-    return p * ggx_reflection_pdf(wo, wi, l.alpha) + (1.0 - p) * (wi.z / PI);
+    let p_specular = l.specular_probability;
+    let p_transmission = l.transmission_probability;
+    var pdf = 0.0;
+    if HAS_TRANSMISSION && p_transmission > 0.0 {
+        pdf = p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo, wi);
+    }
+    if wi.z > 0.0 {
+        pdf += p_specular * ggx_reflection_pdf(wo, wi, l.alpha)
+            + (1.0 - p_specular - p_transmission) * (wi.z / PI);
+    }
+    return pdf;
 }
 
 // `choice` picks the lobe, u the direction; n faces wo.
@@ -109,7 +150,21 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32
     out.is_delta = false;
     let wo_l = to_local(wo, n);
     var wi_l: vec3<f32>;
-    if choice < l.specular_probability {
+    let p_transmission = l.transmission_probability;
+    if HAS_TRANSMISSION && choice < p_transmission {
+        let s = rough_dielectric_sample(l.alpha, l.etap, wo_l, u, choice / p_transmission);
+        out.dir = normalize(from_local(s.wi, n));
+        wi_l = s.wi;
+        if s.refracted {
+            // Only the transmission lobe reaches below: the mixture's f cos / pdf is the lobe's
+            // own weight times its share over its probability (finite at ior 1 too).
+            let share = (1.0 - l.metallic) * l.transmission / p_transmission;
+            out.weight = l.base * (s.weight * share);
+            out.pdf = p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo_l, s.wi);
+            out.is_delta = true;
+            return out;
+        }
+    } else if choice < p_transmission + l.specular_probability {
         let h = sample_ggx_visible_normal(wo_l, l.alpha, u);
         wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
         out.dir = normalize(from_local(wi_l, n));
@@ -119,7 +174,9 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32
     }
     out.pdf = pbr_pdf(l, wo_l, wi_l);
     out.weight = vec3<f32>(0.0);
-    if out.pdf > 0.0 {
+    // A reflection below the surface is absorbed: below, f / pdf counts only the transmission
+    // lobe's refractions, whose density alone pbr_pdf gives there.
+    if out.pdf > 0.0 && wi_l.z > 0.0 {
         out.weight = pbr_eval(l, wo_l, wi_l) / out.pdf;
     }
     return out;

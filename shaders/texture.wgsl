@@ -176,6 +176,10 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
             out.alpha = m.alpha * (t.x * t.x);
             out.metallic = m.metallic * t.y;
         }
+        if m.transmission_texture != NO_TEXTURE {
+            // glTF's transmissionTexture: its R channel multiplies the factor.
+            out.transmission = m.transmission * texture_lookup(m.transmission_texture, uv).x;
+        }
         out.emission = emission_at(m, uv);
     }
     return out;

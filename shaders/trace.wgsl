@@ -79,6 +79,10 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     if aovs_on() {
         (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
     }
+    if HAS_VOLUME && !hit.front_face {
+        // The segment ran inside the volume this surface bounds (volume.wgsl).
+        (*path).throughput *= volume_transmittance(m, hit.t);
+    }
     if any(m.emission > vec3<f32>(0.0)) {
         // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
         // from the previous vertex; camera rays and delta bounces count in full.
@@ -101,7 +105,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
         let light = sample_light(p, origin, &light_rng);
         if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal);
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, hit.front_face);
             if any(f_cos > vec3<f32>(0.0)) {
                 segments += 1u;
                 if HAS_ALPHA {
@@ -110,7 +114,8 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
                     alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
                 }
                 if light_visible(Ray(origin, light.dir), light) {
-                    let weight = nee_weight(light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
+                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, hit.front_face);
+                    let weight = nee_weight(light, pdf);
                     let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
                     (*path).radiance += firefly_clamp(contribution, bounce + 1u);
                 }

@@ -7,9 +7,53 @@
 //! forever), then the opened file itself is checked, so a file swapped between a check and
 //! the open cannot slip through.
 
+use std::cell::RefCell;
 use std::fs::File;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::SystemTime;
+
+/// One version of a file: its modification time and length; `None` where it could not be
+/// opened (missing, or mid-save).
+pub type FileStamp = Option<(SystemTime, u64)>;
+
+/// A file a load asked for, and the version it found.
+pub type FileRead = (PathBuf, FileStamp);
+
+thread_local! {
+    /// The files [`read_regular_file`] was asked for on this thread since
+    /// [`recording_reads`] began, when it is running.
+    static RECORDED_READS: RefCell<Option<Vec<FileRead>>> = const { RefCell::new(None) };
+}
+
+/// Runs `load` and returns, with its result, every file [`read_regular_file`] was asked for
+/// on this thread meanwhile (the scene file, meshes, `.mtl` and `.bin` files, images), each
+/// once, with the version it found: the viewer watches them all for edits.
+pub fn recording_reads<T>(load: impl FnOnce() -> T) -> (T, Vec<FileRead>) {
+    let outer = RECORDED_READS.with(|r| r.replace(Some(Vec::new())));
+    let result = load();
+    let reads = RECORDED_READS
+        .with(|r| r.replace(outer))
+        .unwrap_or_default();
+    (result, reads)
+}
+
+fn record_read(path: &Path, stamp: FileStamp) {
+    RECORDED_READS.with(|r| {
+        if let Some(reads) = r.borrow_mut().as_mut() {
+            match reads.iter_mut().find(|(p, _)| p == path) {
+                Some(read) => read.1 = stamp,
+                None => reads.push((path.to_owned(), stamp)),
+            }
+        }
+    });
+}
+
+/// The version of `path` on disk now.
+pub fn file_stamp(path: &Path) -> FileStamp {
+    let meta = std::fs::metadata(path).ok()?;
+    Some((meta.modified().ok()?, meta.len()))
+}
 
 /// Largest scene file glint reads: far above any hand-written scene (the 700-quad test scene
 /// is 60 KiB; 64 MiB is about 600,000 quads), small enough to parse in seconds.
@@ -55,10 +99,16 @@ fn open_without_blocking(path: &Path) -> std::io::Result<File> {
 /// file: …", "not a regular file (a FIFO)", "the file is 80 MiB; the limit is 64 MiB".
 /// `what` names the kind of file in messages ("scene file").
 pub fn read_regular_file(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> {
-    let file = open_without_blocking(path).map_err(|e| format!("cannot read the {what}: {e}"))?;
-    let meta = file
-        .metadata()
-        .map_err(|e| format!("cannot read the {what}: {e}"))?;
+    let file = open_without_blocking(path).map_err(|e| {
+        record_read(path, None);
+        format!("cannot read the {what}: {e}")
+    })?;
+    let meta = file.metadata().map_err(|e| {
+        record_read(path, None);
+        format!("cannot read the {what}: {e}")
+    })?;
+    // The version of the file opened, not of one swapped in later.
+    record_read(path, meta.modified().ok().map(|m| (m, meta.len())));
     if !meta.is_file() {
         return Err(format!(
             "cannot read the {what}: it is {}, not a regular file",

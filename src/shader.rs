@@ -3,13 +3,13 @@
 use crate::scene::KernelScene;
 use crate::shader_types::{
     BvhNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, LIGHT_SUN, MATERIAL_DIELECTRIC,
-    MATERIAL_METAL, MATERIAL_PBR, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
     PRIMITIVE_TRIANGLE,
 };
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 27] = [
+pub const SHADER_PARTS: [(&str, &str); 29] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -37,6 +37,10 @@ pub const SHADER_PARTS: [(&str, &str); 27] = [
         "ggx_energy.wgsl",
         include_str!("../shaders/ggx_energy.wgsl"),
     ),
+    (
+        "rough_dielectric.wgsl",
+        include_str!("../shaders/rough_dielectric.wgsl"),
+    ),
     ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
@@ -49,6 +53,7 @@ pub const SHADER_PARTS: [(&str, &str); 27] = [
         "environment.wgsl",
         include_str!("../shaders/environment.wgsl"),
     ),
+    ("volume.wgsl", include_str!("../shaders/volume.wgsl")),
     ("lights.wgsl", include_str!("../shaders/lights.wgsl")),
     ("punctual.wgsl", include_str!("../shaders/punctual.wgsl")),
     ("aov.wgsl", include_str!("../shaders/aov.wgsl")),
@@ -257,6 +262,12 @@ pub struct KernelFeatures {
     pub dielectric: bool,
     /// glTF's metallic-roughness material (shaders/pbr.wgsl) and its energy tables.
     pub pbr: bool,
+    /// pbr's transmission lobe (shaders/rough_dielectric.wgsl), for pbr materials with
+    /// transmission.
+    pub transmission: bool,
+    /// Beer–Lambert attenuation inside meshes (shaders/volume.wgsl), for materials with an
+    /// attenuation distance.
+    pub volume: bool,
     /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/aov.wgsl).
     pub aovs: bool,
     /// Textured materials: texture coordinates at hits and lookups (shaders/texture.wgsl).
@@ -283,6 +294,8 @@ impl KernelFeatures {
         metal: true,
         dielectric: true,
         pbr: true,
+        transmission: true,
+        volume: true,
         aovs: true,
         textures: true,
         environment: true,
@@ -304,6 +317,11 @@ impl KernelFeatures {
             metal: has_kind(MATERIAL_METAL),
             dielectric: has_kind(MATERIAL_DIELECTRIC),
             pbr: has_kind(MATERIAL_PBR),
+            transmission: scene.materials.iter().any(|m| {
+                m.kind == MATERIAL_PBR
+                    && (m.transmission > 0.0 || m.transmission_texture != NO_TEXTURE)
+            }),
+            volume: scene.materials.iter().any(|m| m.attenuation_distance > 0.0),
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
             environment: scene.params.environment_width > 0,
@@ -326,6 +344,8 @@ impl KernelFeatures {
             && needs(self.metal, other.metal)
             && needs(self.dielectric, other.dielectric)
             && needs(self.pbr, other.pbr)
+            && needs(self.transmission, other.transmission)
+            && needs(self.volume, other.volume)
             && needs(self.aovs, other.aovs)
             && needs(self.textures, other.textures)
             && needs(self.environment, other.environment)
@@ -340,6 +360,7 @@ impl KernelFeatures {
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
              const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
+             const HAS_TRANSMISSION: bool = {};\nconst HAS_VOLUME: bool = {};\n\
              const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
@@ -351,6 +372,8 @@ impl KernelFeatures {
             self.metal,
             self.dielectric,
             self.pbr,
+            self.pbr && self.transmission,
+            self.volume,
             self.aovs,
             self.textures,
             self.environment,

@@ -3,7 +3,9 @@
 //! Šidák-corrected over the suite's CHI2_TESTS_IN_SUITE tests (tests/common/chi2.rs).
 
 mod common;
-use common::chi2::{assert_fits, directions, directions_integrated, pearson, uniform_2d};
+use common::chi2::{
+    assert_fits, directions, directions_integrated, directions_with_absorbed, pearson, uniform_2d,
+};
 use common::probe::{run_probe, ProbeParams};
 use glam::Vec3;
 use glint::cpu::diffuse::sample_cosine_hemisphere;
@@ -1054,12 +1056,12 @@ fn cpu_pbr_sampling() {
                 specular_color: [1.0; 3],
                 ..Default::default()
             };
-            let p = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n)).specular_probability() as f64;
+            let p = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n), true).specular_probability() as f64;
             let dirs: Vec<Vec3> = (0..SAMPLES)
                 .map(|i| {
                     let mut r = cpu_draws(i, SEED + 97 + k as u32);
                     let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
-                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n);
+                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, true);
                     let above = s.dir.dot(n) > 0.0;
                     assert_eq!(
                         s.weight == Vec3::ZERO,
@@ -1088,5 +1090,258 @@ fn cpu_pbr_sampling() {
                 &directions_integrated(&dirs, n, pdf, 20, 40, 48),
             );
         }
+    }
+}
+
+// ---- Rough dielectric (Walter et al. 2007): reflection and refraction ---------------------
+
+/// The density of the rough dielectric's kept samples (a reflection above the surface, a
+/// refraction below it), written here in f64 from Walter et al.'s formulas with the indices
+/// η_o (wo's side) and η_i (the other side): m from the visible normals, G1(wo) D(m) (wo·m) /
+/// cos θo, then reflection with probability F(wo·m) (Jacobian 1 / (4 wo·m)) or refraction
+/// (Jacobian η_i² |wi·m| / (η_o wo·m + η_i wi·m)²). `n` is the normal on wo's side.
+fn reference_rough_dielectric_pdf(
+    wo: glam::DVec3,
+    wi: glam::DVec3,
+    n: glam::DVec3,
+    alpha: f64,
+    eta_o: f64,
+    eta_i: f64,
+) -> f64 {
+    let (cos_o, cos_i) = (wo.dot(n), wi.dot(n));
+    if cos_o <= 0.0 || cos_i == 0.0 {
+        return 0.0;
+    }
+    let reflected = cos_i > 0.0;
+    let h = if reflected {
+        wo + wi
+    } else {
+        -(eta_o * wo + eta_i * wi)
+    };
+    if h.length() < 1e-9 {
+        return 0.0;
+    }
+    let mut m = h.normalize();
+    if m.dot(n) < 0.0 {
+        m = -m;
+    }
+    let (wo_m, wi_m) = (wo.dot(m), wi.dot(m));
+    if wo_m <= 0.0 || (reflected && wi_m <= 0.0) || (!reflected && wi_m >= 0.0) {
+        return 0.0;
+    }
+    let cos_m = m.dot(n);
+    let a2 = alpha * alpha;
+    let d = a2 / (PI * (cos_m * cos_m * (a2 - 1.0) + 1.0).powi(2));
+    let tan2 = (1.0 - cos_o * cos_o) / (cos_o * cos_o);
+    let g1 = 2.0 / (1.0 + (1.0 + a2 * tan2).sqrt());
+    let visible = g1 * d * wo_m / cos_o;
+    let f = reference_fresnel(wo_m, eta_o, eta_i);
+    if reflected {
+        f * visible / (4.0 * wo_m)
+    } else {
+        let denominator = eta_o * wo_m + eta_i * wi_m;
+        (1.0 - f) * visible * eta_i * eta_i * wi_m.abs() / (denominator * denominator)
+    }
+}
+
+/// (name, entering, θo in degrees): light entering glass at 60°, leaving it at 30° (inside
+/// the critical angle, 41.8°) and at 60° (beyond it: only microfacets tilted towards wo
+/// refract).
+const ROUGH_DIELECTRIC_CASES: [(&str, bool, f32); 3] = [
+    ("entering at 60°", true, 60.0),
+    ("leaving at 30°", false, 30.0),
+    ("leaving at 60°", false, 60.0),
+];
+
+/// The kept samples' directions and the number absorbed.
+fn split_absorbed(samples: &[(Vec3, bool)]) -> (Vec<Vec3>, u64) {
+    let kept: Vec<Vec3> = samples.iter().filter(|s| s.1).map(|s| s.0).collect();
+    let absorbed = (samples.len() - kept.len()) as u64;
+    (kept, absorbed)
+}
+
+/// The rough dielectric's sampler (in its local frame, n = +z) against the reference density,
+/// both ways through the surface, at GGX α 0.04, 0.25 and 1 (roughness 0.2, 0.5, 1).
+#[test]
+fn cpu_rough_dielectric_sampling() {
+    let n = Vec3::Z;
+    for (k, alpha) in [0.04f32, 0.25, 1.0].into_iter().enumerate() {
+        for (c, (name, entering, degrees)) in ROUGH_DIELECTRIC_CASES.into_iter().enumerate() {
+            let theta = (degrees as f64).to_radians();
+            // cos θo exact in f64 for the reference; φ = 0.
+            let wo = Vec3::new(theta.sin() as f32, 0.0, theta.cos() as f32).normalize();
+            let etap = if entering { GLASS_IOR } else { 1.0 / GLASS_IOR };
+            let (eta_o, eta_i) = if entering {
+                (1.0, GLASS_IOR as f64)
+            } else {
+                (GLASS_IOR as f64, 1.0)
+            };
+            let samples: Vec<(Vec3, bool)> = (0..SAMPLES)
+                .map(|i| {
+                    let mut r = cpu_draws(i, SEED + 131 + (3 * k + c) as u32);
+                    let u = (r.next_f32(), r.next_f32());
+                    let s = glint::cpu::rough_dielectric::rough_dielectric_sample(
+                        alpha,
+                        etap,
+                        wo,
+                        u,
+                        r.next_f32(),
+                    );
+                    (s.wi, s.weight > 0.0)
+                })
+                .collect();
+            let (kept, absorbed) = split_absorbed(&samples);
+            let pdf = |d: Vec3| {
+                reference_rough_dielectric_pdf(
+                    wo.as_dvec3(),
+                    d.as_dvec3().normalize(),
+                    n.as_dvec3(),
+                    alpha as f64,
+                    eta_o,
+                    eta_i,
+                )
+            };
+            // The kept samples' pdf as the code computes it matches the reference.
+            for d in kept.iter().take(2000) {
+                let mine = glint::cpu::rough_dielectric::rough_dielectric_pdf(alpha, etap, wo, *d);
+                let want = pdf(*d);
+                assert!(
+                    ((mine as f64) - want).abs() <= 2e-3 * want + 1e-6,
+                    "{name}, α {alpha}: pdf {mine} vs reference {want} at {d}"
+                );
+            }
+            assert_fits(
+                &format!("cpu rough dielectric, α {alpha}, {name}"),
+                &directions_with_absorbed(&kept, absorbed, n, pdf, 20, 40, 48),
+            );
+        }
+    }
+}
+
+/// (transmission, GGX α, entering) of the pbr transmission tests: the rough dielectric alone
+/// (transmission 1) and half of it over the diffuse stack, at roughness 0.3 and 0.8.
+fn pbr_transmission_cases() -> Vec<(f32, f32, bool)> {
+    let mut cases = Vec::new();
+    for transmission in [1.0f32, 0.5] {
+        for alpha in [0.09f32, 0.64] {
+            for entering in [true, false] {
+                cases.push((transmission, alpha, entering));
+            }
+        }
+    }
+    cases
+}
+
+/// The pbr transmission tests' normal and wo (60° from it).
+fn pbr_transmission_geometry() -> (Vec3, Vec3) {
+    let n = Vec3::new(0.2, 0.9, -0.3).normalize();
+    let (t, _) = n.any_orthonormal_pair();
+    (n, 0.5 * n + 0.75f32.sqrt() * t)
+}
+
+fn pbr_glass(albedo: [f32; 3], alpha: f32, transmission: f32) -> glint::shader_types::Material {
+    glint::shader_types::Material {
+        albedo,
+        kind: glint::shader_types::MATERIAL_PBR,
+        alpha,
+        ior: GLASS_IOR,
+        metallic: 0.0,
+        specular: 1.0,
+        specular_color: [1.0; 3],
+        transmission,
+        ..Default::default()
+    }
+}
+
+/// The pbr material with transmission: a mixture of the specular lobe, the cosine lobe and
+/// the rough dielectric with the probabilities `pbr_lobes` reports (which the CPU's material
+/// `m` gives; the GPU's is the same). Kept samples' density is p_s D_vis + p_c cos/π above
+/// the surface, plus p_t times the rough dielectric's (references above); the rest
+/// (reflections below the surface, refractions above it) are absorbed.
+fn check_pbr_transmission_samples(
+    name: &str,
+    m: &glint::shader_types::Material,
+    entering: bool,
+    samples: &[(Vec3, bool)],
+) {
+    let (n, wo) = pbr_transmission_geometry();
+    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), entering);
+    let p_s = lobes.specular_probability() as f64;
+    let p_t = lobes.transmission_probability() as f64;
+    if m.transmission == 1.0 {
+        assert_eq!(p_t, 1.0, "transmission 1 samples only the rough dielectric");
+    }
+    let (eta_o, eta_i) = if entering {
+        (1.0, GLASS_IOR as f64)
+    } else {
+        (GLASS_IOR as f64, 1.0)
+    };
+    let (kept, absorbed) = split_absorbed(samples);
+    let alpha = m.alpha as f64;
+    let pdf = |d: Vec3| {
+        let d = d.as_dvec3().normalize();
+        let (wo, n) = (wo.as_dvec3(), n.as_dvec3());
+        let cos = d.dot(n);
+        let mut p = p_t * reference_rough_dielectric_pdf(wo, d, n, alpha, eta_o, eta_i);
+        if cos > 0.0 {
+            p += p_s * reference_ggx_pdf(wo, d, n, alpha) + (1.0 - p_s - p_t) * cos / PI;
+        }
+        p
+    };
+    assert_fits(
+        name,
+        &directions_with_absorbed(&kept, absorbed, n, pdf, 20, 40, 48),
+    );
+}
+
+fn pbr_transmission_name(device: &str, transmission: f32, alpha: f32, entering: bool) -> String {
+    let side = if entering { "entering" } else { "leaving" };
+    format!("{device} pbr, transmission {transmission}, α {alpha}, {side}")
+}
+
+#[test]
+fn cpu_pbr_transmission_sampling() {
+    let (n, wo) = pbr_transmission_geometry();
+    for (k, (transmission, alpha, entering)) in pbr_transmission_cases().into_iter().enumerate() {
+        let m = pbr_glass([0.8, 0.5, 0.3], alpha, transmission);
+        let samples: Vec<(Vec3, bool)> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 151 + k as u32);
+                let s = glint::cpu::material::bsdf_sample(&m, wo, n, entering, &mut r);
+                let kept = s.weight != Vec3::ZERO;
+                if kept {
+                    // Refraction is marked delta (light sampling cannot reach it).
+                    assert_eq!(s.is_delta, s.dir.dot(n) < 0.0, "is_delta at {}", s.dir);
+                }
+                (s.dir, kept)
+            })
+            .collect();
+        let name = pbr_transmission_name("cpu", transmission, alpha, entering);
+        check_pbr_transmission_samples(&name, &m, entering, &samples);
+    }
+}
+
+/// The WGSL sampler (tests/shaders/probe.wgsl's probe_pbr: a white base) against the same
+/// reference.
+#[test]
+fn gpu_pbr_transmission_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    let (n, wo) = pbr_transmission_geometry();
+    for (k, (transmission, alpha, entering)) in pbr_transmission_cases().into_iter().enumerate() {
+        let m = pbr_glass([1.0; 3], alpha, transmission);
+        let params = ProbeParams {
+            wo: wo.into(),
+            alpha,
+            ior: GLASS_IOR,
+            front_face: entering as u32,
+            transmission,
+            ..probe(n, SAMPLES, SEED + 171 + k as u32)
+        };
+        let samples: Vec<(Vec3, bool)> = run_probe(ctx, "probe_pbr", params, &empty_scene())
+            .iter()
+            .map(|s| (Vec3::new(s[0], s[1], s[2]), s[3] != 0.0))
+            .collect();
+        let name = pbr_transmission_name("gpu", transmission, alpha, entering);
+        check_pbr_transmission_samples(&name, &m, entering, &samples);
     }
 }

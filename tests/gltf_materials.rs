@@ -123,6 +123,10 @@ fn metallic_roughness_factors_and_extensions_become_pbr() {
             ior: 1.33,
             specular: 0.7,
             specular_color: Vec3::new(1.0, 0.5, 2.0),
+            transmission: 0.0,
+            transmission_texture: None,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: None,
         }
     );
     assert_eq!(m.color, Vec3::new(0.8, 0.5, 0.25));
@@ -143,31 +147,77 @@ fn absent_factors_take_gltfs_defaults() {
             ior: 1.5,
             specular: 1.0,
             specular_color: Vec3::ONE,
+            transmission: 0.0,
+            transmission_texture: None,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: None,
         }
     );
     assert_eq!(m.color, Vec3::ONE);
     assert_eq!(m.emitted_radiance, Vec3::ZERO);
 }
 
-/// Transmission stays a smooth dielectric, with a warning that says what is lost.
+/// KHR_materials_transmission and KHR_materials_volume become the pbr material's
+/// transmission and attenuation (rough, partly transmissive: no warning, and none for the
+/// extensions, which glint reads entirely; thicknessFactor is for rasterisers and ignored),
+/// and both may be required.
 #[test]
-fn transmission_is_a_smooth_dielectric_with_a_warning() {
+fn transmission_and_volume_become_pbr_without_a_warning() {
     let material = serde_json::json!({
-        "pbrMetallicRoughness": {"roughnessFactor": 0.3},
+        "pbrMetallicRoughness": {"roughnessFactor": 0.3, "metallicFactor": 0.0},
         "extensions": {
             "KHR_materials_transmission": {"transmissionFactor": 0.4},
+            "KHR_materials_volume": {
+                "thicknessFactor": 0.5,
+                "attenuationColor": [0.9, 0.5, 0.25],
+                "attenuationDistance": 2.0
+            },
             "KHR_materials_ior": {"ior": 1.4}
         }
     });
     let m = loaded_material(material.clone());
-    assert_eq!(m.kind, MaterialKind::Dielectric { ior: 1.4 });
-    let (json, bin) = triangle_gltf(material);
+    assert_eq!(
+        m.kind,
+        MaterialKind::Pbr {
+            roughness: 0.3,
+            metallic: 0.0,
+            ior: 1.4,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+            transmission: 0.4,
+            transmission_texture: None,
+            attenuation_color: Vec3::new(0.9, 0.5, 0.25),
+            attenuation_distance: Some(2.0),
+        }
+    );
+    let (mut json, bin) = triangle_gltf(material);
+    json["extensionsUsed"] = serde_json::json!([
+        "KHR_materials_transmission",
+        "KHR_materials_volume",
+        "KHR_materials_ior"
+    ]);
+    json["extensionsRequired"] =
+        serde_json::json!(["KHR_materials_transmission", "KHR_materials_volume"]);
     let warnings = render_warnings(&json, &bin);
     assert!(
-        warnings.iter().any(|w| w.contains("materials[0]")
-            && w.contains("KHR_materials_transmission 0.4")
-            && w.contains("smooth")),
+        !warnings
+            .iter()
+            .any(|w| w.contains("transmission") || w.contains("volume")),
         "{warnings:?}"
+    );
+    // The kernel's material carries them (attenuation 0 stands for glTF's +∞).
+    let scene = load(&json, &bin).unwrap();
+    let index = scene.triangles[0].material as usize;
+    let k = scene.kernel_scene().materials[index];
+    assert_eq!(
+        (k.transmission, k.attenuation_color, k.attenuation_distance),
+        (0.4, [0.9, 0.5, 0.25], 2.0)
+    );
+    let plain = load(&triangle_gltf(serde_json::json!({})).0, &bin).unwrap();
+    let k = plain.kernel_scene().materials[plain.triangles[0].material as usize];
+    assert_eq!(
+        (k.transmission, k.attenuation_color, k.attenuation_distance),
+        (0.0, [1.0; 3], 0.0)
     );
 }
 
@@ -191,6 +241,36 @@ fn factors_out_of_range_are_errors() {
             serde_json::json!({"extensions": {"KHR_materials_specular":
                 {"specularColorFactor": [1, -1, 1]}}}),
             &["material0", "specularColorFactor must be ≥ 0"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_transmission":
+                {"transmissionFactor": 1.5}}}),
+            &["material0", "transmissionFactor must be in [0, 1]", "1.5"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_transmission":
+                {"transmissionFactor": -0.25}}}),
+            &["material0", "transmissionFactor must be in [0, 1]"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_volume":
+                {"attenuationDistance": 0}}}),
+            &["material0", "attenuationDistance must be > 0"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_volume":
+                {"attenuationDistance": -3}}}),
+            &["material0", "attenuationDistance must be > 0", "-3"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_volume":
+                {"attenuationColor": [1.5, 0.5, 0.5]}}}),
+            &["material0", "attenuationColor must be in [0, 1]"][..],
+        ),
+        (
+            serde_json::json!({"extensions": {"KHR_materials_volume":
+                {"attenuationColor": [0.5, -0.5, 0.5]}}}),
+            &["material0", "attenuationColor must be in [0, 1]"][..],
         ),
     ] {
         let (json, bin) = triangle_gltf(material);
@@ -275,7 +355,8 @@ fn load_glb(bytes: &[u8]) -> Result<Scene, String> {
 }
 
 /// The textured material: base colour from a data: URI, metallic-roughness from the .glb's
-/// buffer view, both multiplying their factors.
+/// buffer view, all multiplying their factors; the base colour's image is also the
+/// transmission texture (its red channel, linear).
 fn textured_glb() -> Vec<u8> {
     use base64::Engine as _;
     let uri = format!(
@@ -288,7 +369,10 @@ fn textured_glb() -> Vec<u8> {
         "roughnessFactor": 0.8,
         "baseColorTexture": {"index": 0},
         "metallicRoughnessTexture": {"index": 1}
-    }});
+    }, "extensions": {"KHR_materials_transmission": {
+        "transmissionFactor": 0.5,
+        "transmissionTexture": {"index": 0}
+    }}});
     glb(material, &[png(METALLIC_ROUGHNESS_TEXELS)], |g| {
         g["images"]
             .as_array_mut()
@@ -300,7 +384,7 @@ fn textured_glb() -> Vec<u8> {
 
 /// At each texel centre, on both devices, the material's colour is baseColorFactor × the
 /// sRGB-decoded texel, its roughness roughnessFactor × green and its metallic metallicFactor
-/// × blue (the texels are exact at power-of-two texel centres, tests/textures.rs; the
+/// × blue, its transmission transmissionFactor × red (the texels are exact at power-of-two texel centres, tests/textures.rs; the
 /// products are the same f32 operations on both sides, so they agree to an ulp or two).
 #[test]
 fn embedded_textures_multiply_their_factors_on_both_devices() {
@@ -344,8 +428,14 @@ fn embedded_textures_multiply_their_factors_on_both_devices() {
             "texel {i}: metallic {}",
             m.metallic
         );
+        let transmission = 0.5 * (c[0] as f32 / 255.0);
+        assert!(
+            (m.transmission - transmission).abs() < 1e-6,
+            "texel {i}: transmission {}",
+            m.transmission
+        );
         cpu.push([m.albedo[0], m.albedo[1], m.albedo[2], m.alpha]);
-        cpu.push([m.metallic, 0.0, 0.0, 0.0]);
+        cpu.push([m.metallic, m.transmission, 0.0, 0.0]);
     }
     let Some(ctx) = common::gpu() else { return };
     let mut probed = scene.clone();

@@ -371,6 +371,9 @@ fn every_feature_combination_validates() {
             // Not another bit (that would double the test's time): a function of the bits that
             // meets every other feature both on and off.
             pbr: (bits.count_ones() / 2) % 2 == 1,
+            // Likewise: on with pbr in some combinations and without it in others.
+            transmission: (bits / 3) % 2 == 1,
+            volume: (bits / 5) % 2 == 1,
             // Likewise: on in half the combinations, with and without textures and triangles.
             alpha: (bits * 5 / 3) % 2 == 1,
         };
@@ -403,6 +406,8 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         metal: false,
         dielectric: false,
         pbr: false,
+        transmission: false,
+        volume: false,
         aovs: false,
         textures: false,
         environment: false,

@@ -67,7 +67,7 @@ fn a_white_pbr_material_reflects_everything_at_every_angle() {
     }
 }
 
-/// f(wo, wi) = f(wi, wo): bsdf_eval returns f · cos θi, so f(wo, wi) cos θo (the eval with
+/// f(wo, wi) = f(wi, wo) for the reflection: bsdf_eval returns f · cos θi, so f(wo, wi) cos θo (the eval with
 /// the roles swapped, times cos θo / cos θi) must match, to f32 rounding.
 #[test]
 fn the_pbr_brdf_is_reciprocal() {
@@ -82,6 +82,9 @@ fn the_pbr_brdf_is_reciprocal() {
     for k in 0..2000 {
         let m = Material {
             albedo: [rng.next_f32(), rng.next_f32(), rng.next_f32()],
+            // The transmission lobe's reflection too, from outside and inside (its
+            // refraction's reciprocity is in tests/transmission.rs).
+            transmission: rng.next_f32(),
             ..pbr(
                 0.0,
                 rng.next_f32(),
@@ -91,8 +94,8 @@ fn the_pbr_brdf_is_reciprocal() {
             )
         };
         let (wo, wi) = (random_direction(&mut rng), random_direction(&mut rng));
-        let forward = bsdf_eval(&m, wo, wi, n) / wi.z;
-        let backward = bsdf_eval(&m, wi, wo, n) / wo.z;
+        let forward = bsdf_eval(&m, wo, wi, n, k % 2 == 0) / wi.z;
+        let backward = bsdf_eval(&m, wi, wo, n, k % 2 == 0) / wo.z;
         let scale = forward.max_element().max(1e-3);
         assert!(
             (forward - backward).abs().max_element() <= 2e-4 * scale,

@@ -181,7 +181,7 @@ fn bvh_top_nodes_in_a_uniform_buffer_do_not_change_the_image() {
 /// Kernels with unused features compiled out render exactly what the kernel with everything
 /// renders: the flags only remove code a scene cannot reach. The scenes cover each flag both
 /// ways: light sampling on and off; quad emitters only, sphere emitters only, and both; metal
-/// and glass present and absent.
+/// and glass present and absent; transmission and volumes (the pbr grid) present and absent.
 #[test]
 fn compiled_out_features_do_not_change_the_image() {
     let Some(ctx) = gpu() else { return };
@@ -204,6 +204,10 @@ fn compiled_out_features_do_not_change_the_image() {
         (
             "point, spot and sun lights",
             sized(shipped_scene("lights.toml"), 32, 7),
+        ),
+        (
+            "pbr grid with glass and a volume",
+            sized(shipped_scene("materials.toml"), 32, 8),
         ),
     ];
     let mut variants_seen = Vec::new();
@@ -238,9 +242,11 @@ fn compiled_out_features_do_not_change_the_image() {
             f.textures,
             f.lights,
             f.sun_disks,
+            f.transmission,
+            f.volume,
         ]
     };
-    for i in 0..8 {
+    for i in 0..10 {
         assert!(
             variants_seen.iter().any(|f| flags(f)[i]),
             "flag {i} never on"

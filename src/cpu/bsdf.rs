@@ -9,5 +9,7 @@ pub struct BsdfSample {
     pub weight: Vec3,
     /// Solid-angle pdf of `dir`; 0 for delta lobes.
     pub pdf: f32,
+    /// Light sampling cannot find `dir`, so what the ray reaches counts in full: delta lobes,
+    /// and refraction (shadow rays do not pass through surfaces).
     pub is_delta: bool,
 }

@@ -1,5 +1,6 @@
 //! The BSDF of each material kind, dispatched to its lobes (WGSL side: `shaders/material.wgsl`):
-//! `diffuse.rs`, `conductor.rs`, `dielectric.rs`, `pbr.rs`, on `microfacet.rs` and `frame.rs`.
+//! `diffuse.rs`, `conductor.rs`, `dielectric.rs`, `pbr.rs` (with `rough_dielectric.rs`), on
+//! `microfacet.rs` and `frame.rs`.
 
 pub use super::bsdf::BsdfSample;
 use super::conductor::{conductor_eval, conductor_sample, MIN_METAL_ALPHA};
@@ -21,15 +22,16 @@ pub fn is_delta(m: &Material) -> bool {
         || (m.kind == MATERIAL_METAL && m.alpha < MIN_METAL_ALPHA)
 }
 
-/// f · cos θi for light arriving from wi and leaving towards wo (n faces wo). Zero for delta
-/// lobes and for wi below the surface.
-pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
+/// f · cos θi for light arriving from wi and leaving towards wo (n faces wo; `front_face` says
+/// whether that is the outside). Zero for delta lobes and for wi below the surface (light
+/// sampling's shadow rays do not pass through surfaces).
+pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, front_face: bool) -> Vec3 {
     let cos_i = wi.dot(n);
     if cos_i <= 0.0 || is_delta(m) {
         return Vec3::ZERO;
     }
     if m.kind == MATERIAL_PBR {
-        let lobes = pbr_lobes(m, wo.dot(n));
+        let lobes = pbr_lobes(m, wo.dot(n), front_face);
         return pbr_eval(&lobes, to_local(wo, n), to_local(wi, n));
     }
     if m.kind == MATERIAL_METAL {
@@ -44,12 +46,12 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> Vec3 {
 }
 
 /// The solid-angle pdf with which [`bsdf_sample`] returns wi.
-pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> f32 {
+pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, front_face: bool) -> f32 {
     if is_delta(m) {
         return 0.0;
     }
     if m.kind == MATERIAL_PBR {
-        let lobes = pbr_lobes(m, wo.dot(n));
+        let lobes = pbr_lobes(m, wo.dot(n), front_face);
         return pbr_pdf(&lobes, to_local(wo, n), to_local(wi, n));
     }
     if m.kind == MATERIAL_METAL {
@@ -59,7 +61,7 @@ pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3) -> f32 {
 }
 
 /// Samples the direction light arrives from, for light leaving towards wo. `n` faces wo;
-/// `front_face` says whether that is the outside (for glass).
+/// `front_face` says whether that is the outside (for glass and transmission).
 pub fn bsdf_sample(m: &Material, wo: Vec3, n: Vec3, front_face: bool, rng: &mut Rng) -> BsdfSample {
     if m.kind == MATERIAL_SPECULAR {
         return BsdfSample {
@@ -74,7 +76,7 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, n: Vec3, front_face: bool, rng: &mut 
     }
     let u = (rng.next_f32(), rng.next_f32());
     if m.kind == MATERIAL_PBR {
-        let lobes = pbr_lobes(m, wo.dot(n));
+        let lobes = pbr_lobes(m, wo.dot(n), front_face);
         return pbr_sample(&lobes, wo, n, rng.next_f32(), u);
     }
     if m.kind == MATERIAL_METAL {

@@ -23,11 +23,13 @@ pub mod pbr;
 pub mod punctual;
 pub mod renderer;
 pub mod rng;
+pub mod rough_dielectric;
 pub mod shading_normal;
 pub mod surface;
 pub mod texture;
 pub mod trace;
 pub mod triangle;
+pub mod volume;
 
 use glam::Vec3;
 

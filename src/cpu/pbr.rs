@@ -15,15 +15,28 @@
 //!   dielectric layer's whole albedo (single and multiple scattering). White over white
 //!   reflects everything too; where the layer reflects more, the base gets less.
 //!
-//! The tables E, Es are looked up in `ggx_energy.rs`. Sampling picks the specular lobe (visible
-//! normals) or a cosine lobe (for the diffuse and multiple-scattering lobes) with probabilities
-//! from their albedos at μo, and weights by the mixture pdf, which MIS uses too.
+//! - Transmission (KHR_materials_transmission): the extension's dielectric BRDF is
+//!   fresnel_mix(layer = specular, base = mix(diffuse, btdf · base colour, transmission)),
+//!   which is (1 − T) · (the stack above) + T · (the rough dielectric of `rough_dielectric.rs`,
+//!   its refraction tinted by the base colour), T the transmission. The rough dielectric has
+//!   the exact Fresnel term of the ior (it decides total internal reflection from inside) and
+//!   no energy compensation; KHR_materials_specular does not change it.
+//!
+//! The tables E, Es are looked up in `ggx_energy.rs`. Sampling picks the transmission lobe,
+//! the specular lobe (visible normals) or a cosine lobe (for the diffuse and
+//! multiple-scattering lobes) with probabilities from their albedos at μo, and weights by the
+//! mixture pdf, which MIS uses too. Refracted samples are marked delta: shadow rays do not
+//! pass through surfaces, so light sampling cannot find what lies behind one, and what such a
+//! sample reaches must count in full.
 
 use super::bsdf::BsdfSample;
 use super::diffuse::sample_cosine_hemisphere;
 use super::frame::{from_local, to_local, PI};
 use super::ggx_energy::{ggx_albedo, ggx_albedo_average};
 use super::microfacet::{ggx_d, ggx_lambda, ggx_reflection_pdf, sample_ggx_visible_normal};
+use super::rough_dielectric::{
+    rough_dielectric_eval, rough_dielectric_pdf, rough_dielectric_sample,
+};
 use crate::shader_types::Material;
 use glam::Vec3;
 
@@ -51,8 +64,13 @@ pub struct PbrLobes {
     /// The dielectric layer's whole albedo at μo, and its average.
     layer_o: Vec3,
     layer_average: Vec3,
-    /// Probability of sampling the specular lobe.
+    /// The transmissive share T of the dielectric part, and η(the other side) / η(wo's side).
+    transmission: f32,
+    etap: f32,
+    /// Probabilities of sampling the specular lobe and the transmission lobe (the cosine lobe
+    /// has the rest).
     specular_probability: f32,
+    transmission_probability: f32,
 }
 
 fn average(v: Vec3) -> f32 {
@@ -70,9 +88,15 @@ impl PbrLobes {
     pub fn specular_probability(&self) -> f32 {
         self.specular_probability
     }
+
+    /// The probability with which [`pbr_sample`] samples the transmission lobe.
+    pub fn transmission_probability(&self) -> f32 {
+        self.transmission_probability
+    }
 }
 
-pub fn pbr_lobes(m: &Material, mu_o: f32) -> PbrLobes {
+/// `front_face` says whether wo is on the outside (which decides η for transmission).
+pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
     let base = Vec3::from(m.albedo);
     let alpha = m.alpha.max(PBR_MIN_ALPHA);
     let r = (m.ior - 1.0) / (m.ior + 1.0);
@@ -93,15 +117,25 @@ pub fn pbr_lobes(m: &Material, mu_o: f32) -> PbrLobes {
         + Vec3::splat(dielectric_f90 * b_average)
         + ms_dielectric * (1.0 - e_average);
     let metallic = m.metallic;
-    let specular = (1.0 - metallic) * (dielectric_f0 * a_o + Vec3::splat(dielectric_f90 * b_o))
+    let transmission = m.transmission;
+    // The opaque dielectric stack's share.
+    let opaque = (1.0 - metallic) * (1.0 - transmission);
+    let specular = opaque * (dielectric_f0 * a_o + Vec3::splat(dielectric_f90 * b_o))
         + metallic * (base * a_o + Vec3::splat(b_o));
-    let ms = ((1.0 - metallic) * ms_dielectric + metallic * ms_metal) * (1.0 - e_o);
-    let diffuse = (1.0 - metallic) * base * (Vec3::ONE - layer_o);
+    let ms = (opaque * ms_dielectric + metallic * ms_metal) * (1.0 - e_o);
+    let diffuse = opaque * base * (Vec3::ONE - layer_o);
     let specular_weight = average(specular);
     let other_weight = average(ms + diffuse);
-    let total = specular_weight + other_weight;
-    let specular_probability = if total > 0.0 {
-        (specular_weight / total).clamp(MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY)
+    let transmission_weight = (1.0 - metallic) * transmission;
+    let opaque_total = specular_weight + other_weight;
+    let total = opaque_total + transmission_weight;
+    let transmission_probability = if total > 0.0 {
+        transmission_weight / total
+    } else {
+        0.0
+    };
+    let specular_share = if opaque_total > 0.0 {
+        (specular_weight / opaque_total).clamp(MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY)
     } else {
         0.5
     };
@@ -117,29 +151,41 @@ pub fn pbr_lobes(m: &Material, mu_o: f32) -> PbrLobes {
         ms_metal,
         layer_o,
         layer_average,
-        specular_probability,
+        transmission,
+        etap: if front_face { m.ior } else { 1.0 / m.ior },
+        specular_probability: (1.0 - transmission_probability) * specular_share,
+        transmission_probability,
     }
 }
 
 /// f · cos θi; wo and wi in the local frame.
 pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
+    let l = lobes;
+    // The transmission lobe's share of the whole.
+    let transmissive = (1.0 - l.metallic) * l.transmission;
+    if wo.z <= 0.0 || wi.z == 0.0 {
         return Vec3::ZERO;
     }
-    let l = lobes;
+    if wi.z < 0.0 {
+        if transmissive <= 0.0 {
+            return Vec3::ZERO;
+        }
+        return l.base * (transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+    }
+    let opaque = (1.0 - l.metallic) * (1.0 - l.transmission);
     let h = (wo + wi).normalize();
     let c = (1.0 - wo.dot(h)).clamp(0.0, 1.0);
     let s5 = c * c * c * c * c;
     let f_dielectric = l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * s5;
     let f_metal = l.base + (Vec3::ONE - l.base) * s5;
-    let fresnel = (1.0 - l.metallic) * f_dielectric + l.metallic * f_metal;
+    let fresnel = opaque * f_dielectric + l.metallic * f_metal;
     let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
     let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
     let (a_i, b_i) = ggx_albedo(wi.z, l.alpha);
     let e_i = a_i + b_i;
     let mut out = specular;
     if l.e_average < 1.0 {
-        let ms = (1.0 - l.metallic) * l.ms_dielectric + l.metallic * l.ms_metal;
+        let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
         out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
     }
     let layer_i =
@@ -163,22 +209,52 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
             0.0
         },
     );
-    out + (1.0 - l.metallic) * l.base * base_weight * (wi.z / PI)
+    out += opaque * l.base * base_weight * (wi.z / PI);
+    if transmissive > 0.0 {
+        out += Vec3::splat(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+    }
+    out
 }
 
 /// The mixture pdf of [`pbr_sample`]; wo and wi in the local frame.
 pub fn pbr_pdf(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> f32 {
-    if wo.z <= 0.0 || wi.z <= 0.0 {
+    if wo.z <= 0.0 {
         return 0.0;
     }
-    let p = lobes.specular_probability;
-    p * ggx_reflection_pdf(wo, wi, lobes.alpha) + (1.0 - p) * (wi.z / PI)
+    let (p_specular, p_transmission) = (lobes.specular_probability, lobes.transmission_probability);
+    let mut pdf = 0.0;
+    if p_transmission > 0.0 {
+        pdf = p_transmission * rough_dielectric_pdf(lobes.alpha, lobes.etap, wo, wi);
+    }
+    if wi.z > 0.0 {
+        pdf += p_specular * ggx_reflection_pdf(wo, wi, lobes.alpha)
+            + (1.0 - p_specular - p_transmission) * (wi.z / PI);
+    }
+    pdf
 }
 
 /// `choice` picks the lobe, `u` the direction; `n` faces wo.
 pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32)) -> BsdfSample {
     let wo_l = to_local(wo, n);
-    let (dir, wi_l) = if choice < lobes.specular_probability {
+    let l = lobes;
+    let p_transmission = l.transmission_probability;
+    let (dir, wi_l) = if choice < p_transmission {
+        let s = rough_dielectric_sample(l.alpha, l.etap, wo_l, u, choice / p_transmission);
+        let dir = from_local(s.wi, n).normalize();
+        if s.refracted {
+            // Only the transmission lobe reaches below: the mixture's f cos / pdf is the
+            // lobe's own weight times its share over its probability (and at ior 1, where the
+            // lobe is a delta, this stays finite where f and pdf do not).
+            let share = (1.0 - l.metallic) * l.transmission / p_transmission;
+            return BsdfSample {
+                dir,
+                weight: l.base * (s.weight * share),
+                pdf: p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo_l, s.wi),
+                is_delta: true,
+            };
+        }
+        (dir, s.wi)
+    } else if choice < p_transmission + lobes.specular_probability {
         let h = sample_ggx_visible_normal(wo_l, lobes.alpha, u);
         let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
         (from_local(wi_l, n).normalize(), wi_l)
@@ -187,7 +263,9 @@ pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32
         (dir, to_local(dir, n))
     };
     let pdf = pbr_pdf(lobes, wo_l, wi_l);
-    let weight = if pdf > 0.0 {
+    // A reflection below the surface is absorbed: below, f / pdf counts only the transmission
+    // lobe's refractions, whose density alone pbr_pdf gives there.
+    let weight = if pdf > 0.0 && wi_l.z > 0.0 {
         pbr_eval(lobes, wo_l, wi_l) / pdf
     } else {
         Vec3::ZERO

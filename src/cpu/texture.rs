@@ -202,6 +202,10 @@ pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
         out.alpha = m.alpha * (t.x * t.x);
         out.metallic = m.metallic * t.y;
     }
+    if m.transmission_texture != NO_TEXTURE {
+        // glTF's transmissionTexture: its R channel multiplies the factor.
+        out.transmission = m.transmission * texture_lookup(textures, m.transmission_texture, uv).x;
+    }
     out.emission = emission_at(textures, m, uv).into();
     out
 }

@@ -15,6 +15,7 @@ use super::punctual::sun_disks_radiance;
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::surface::offset_ray_origin;
 use super::texture::{material_at, Textures};
+use super::volume::volume_transmittance;
 use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader::has_alpha;
@@ -235,6 +236,10 @@ pub fn path_step(
     if aovs_on(params) {
         aov_record_hit(&mut path.aov, bounce, &hit, m);
     }
+    // The kernel compiles this in only for scenes with attenuating volumes (HAS_VOLUME).
+    if !hit.front_face {
+        path.throughput *= volume_transmittance(m, hit.t);
+    }
     let emission = Vec3::from(m.emission);
     if emission.cmpgt(Vec3::ZERO).any() {
         // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
@@ -265,7 +270,7 @@ pub fn path_step(
         let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
         let light = sample_light(scene, p, origin, &mut light_rng);
         if light.pdf > 0.0 && !crosses_shading_side(light.dir, &hit) {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal);
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, hit.front_face);
             if f_cos.cmpgt(Vec3::ZERO).any() {
                 let shadow = Ray {
                     origin,
@@ -283,7 +288,8 @@ pub fn path_step(
                     scene
                 };
                 if light_visible(shadow_scene, &shadow, &light) {
-                    let weight = nee_weight(&light, bsdf_pdf(m, wo, light.dir, hit.shading_normal));
+                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, hit.front_face);
+                    let weight = nee_weight(&light, pdf);
                     let contribution =
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);
                     path.radiance += firefly_clamp(params, contribution, bounce + 1);

@@ -111,6 +111,10 @@ pub(super) struct MaterialToml {
     pub(super) metallic: Option<S<Real>>,
     pub(super) specular: Option<S<Real>>,
     pub(super) specular_color: Option<S<Triple>>,
+    /// KHR_materials_transmission and KHR_materials_volume, for `type = "pbr"`.
+    pub(super) transmission: Option<S<Real>>,
+    pub(super) attenuation_color: Option<S<Triple>>,
+    pub(super) attenuation_distance: Option<S<Real>>,
     /// Any type, on meshes: `"opaque"` (the default), `"mask"` or `"blend"` (glTF's alphaMode),
     /// the constant `alpha` (which a colour texture's alpha multiplies) and the mask's
     /// `alpha_cutoff`.

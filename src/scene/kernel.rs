@@ -226,6 +226,9 @@ impl Scene {
             .iter()
             .map(|m| {
                 let (mut metallic, mut specular, mut specular_color) = (0.0, 0.0, Vec3::ZERO);
+                // No transmission nor attenuation but where a pbr material asks for them.
+                let (mut transmission, mut transmission_texture) = (0.0, NO_TEXTURE);
+                let (mut attenuation_color, mut attenuation_distance) = (Vec3::ONE, 0.0);
                 let (kind, alpha, ior) = match m.kind {
                     MaterialKind::Diffuse => (MATERIAL_DIFFUSE, 0.0, 1.0),
                     MaterialKind::Specular => (MATERIAL_SPECULAR, 0.0, 1.0),
@@ -239,8 +242,16 @@ impl Scene {
                         ior,
                         specular: s,
                         specular_color: c,
+                        transmission: t,
+                        transmission_texture: t_texture,
+                        attenuation_color: a_color,
+                        attenuation_distance: a_distance,
                     } => {
                         (metallic, specular, specular_color) = (m, s, c);
+                        (transmission, transmission_texture) = (t, t_texture.unwrap_or(NO_TEXTURE));
+                        if let Some(d) = a_distance {
+                            (attenuation_color, attenuation_distance) = (a_color, d);
+                        }
                         (MATERIAL_PBR, roughness * roughness, ior)
                     }
                 };
@@ -269,10 +280,10 @@ impl Scene {
                         // glTF's default, unread.
                         AlphaMode::Opaque | AlphaMode::Blend => 0.5,
                     },
-                    transmission: 0.0,
-                    transmission_texture: NO_TEXTURE,
-                    attenuation_color: [1.0; 3],
-                    attenuation_distance: 0.0,
+                    transmission,
+                    transmission_texture,
+                    attenuation_color: attenuation_color.into(),
+                    attenuation_distance,
                 }
             })
             .collect();

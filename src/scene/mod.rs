@@ -171,6 +171,14 @@ pub enum MaterialKind {
         ior: f32,
         specular: f32,
         specular_color: Vec3,
+        /// The transmissive share of the dielectric part (KHR_materials_transmission), and
+        /// the index into [`Scene::textures`] of a texture whose first channel multiplies it.
+        transmission: f32,
+        transmission_texture: Option<u32>,
+        /// Beer–Lambert attenuation inside the mesh (KHR_materials_volume): the colour white
+        /// light has after `attenuation_distance`; None for none (glTF's +∞).
+        attenuation_color: Vec3,
+        attenuation_distance: Option<f32>,
     },
 }
 

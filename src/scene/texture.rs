@@ -47,6 +47,11 @@ pub enum TextureUse {
     MetallicRoughness,
     /// A tangent-space normal map (glTF's normalTexture): linear, every channel in [0, 1].
     Normal,
+    /// glTF's transmissionTexture: linear, the first (red) channel in [0, 1].
+    Transmission,
+    /// OBJ's separate `map_Pr` and `map_Pm` images merged into one on load
+    /// ([`TextureSet::roughness_and_metallic`]): roughness in red, metallic in green.
+    RoughnessAndMetallic,
 }
 
 /// Every texture of a scene, as the kernel reads them.
@@ -80,6 +85,82 @@ impl TextureSet {
         }
         let image = load_linear_image(path, encoding(usage))?;
         self.add(key, &path.display().to_string(), image, usage)
+    }
+
+    /// One texture from OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, as
+    /// the kernel reads a roughness texture: x the roughness (each image's first channel), y
+    /// the metallic factor, 1 where an image is absent. The metallic image is resampled
+    /// (nearest) to the roughness image's size where they differ. The error names the image.
+    pub fn roughness_and_metallic(
+        &mut self,
+        roughness: Option<&Path>,
+        metallic: Option<&Path>,
+    ) -> Result<u32, String> {
+        let canonical = |p: Option<&Path>| {
+            p.map(|p| p.canonicalize().unwrap_or_else(|_| p.to_owned()))
+                .map_or(String::new(), |p| p.display().to_string())
+        };
+        // A key no file path has: both paths after a '#'.
+        let key = (
+            PathBuf::from(format!(
+                "#roughness={}#metallic={}",
+                canonical(roughness),
+                canonical(metallic)
+            )),
+            TextureUse::RoughnessAndMetallic,
+        );
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        let load = |p: Option<&Path>| {
+            p.map(|p| {
+                load_linear_image(p, Encoding::Linear)
+                    .map_err(|e| format!("texture {}: {e}", p.display()))
+            })
+            .transpose()
+        };
+        let (roughness_image, metallic_image) = (load(roughness)?, load(metallic)?);
+        let (width, height) = match (&roughness_image, &metallic_image) {
+            (Some(i), _) | (None, Some(i)) => (i.width, i.height),
+            (None, None) => return Err("no roughness or metallic image".into()),
+        };
+        let first_channel = |image: &Option<LinearImage>, x: u32, y: u32| {
+            image.as_ref().map_or(1.0, |i| {
+                // Nearest texel of an image of another size.
+                let xi = (u64::from(x) * u64::from(i.width) / u64::from(width)) as u32;
+                let yi = (u64::from(y) * u64::from(i.height) / u64::from(height)) as u32;
+                i.texel(xi, yi)[0]
+            })
+        };
+        let mut texels = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height {
+            for x in 0..width {
+                texels.push([
+                    first_channel(&roughness_image, x, y),
+                    first_channel(&metallic_image, x, y),
+                    1.0,
+                ]);
+            }
+        }
+        let clamped = roughness_image
+            .as_ref()
+            .and_then(|i| i.clamped)
+            .or(metallic_image.as_ref().and_then(|i| i.clamped));
+        let shown = [roughness, metallic]
+            .iter()
+            .flatten()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" and ");
+        let image = LinearImage {
+            width,
+            height,
+            texels,
+            alpha: Vec::new(),
+            clamped,
+        };
+        self.add(key, &shown, image, TextureUse::RoughnessAndMetallic)
+            .map_err(|e| format!("texture {shown}: {e}"))
     }
 
     /// The texture of an image file's bytes embedded in `file` as `element` (a glTF file's
@@ -120,8 +201,9 @@ impl TextureSet {
         // The channels the use reads.
         let channels = match usage {
             TextureUse::Color | TextureUse::Normal => 0..3,
-            TextureUse::Roughness => 0..1,
+            TextureUse::Roughness | TextureUse::Transmission => 0..1,
             TextureUse::MetallicRoughness => 1..3,
+            TextureUse::RoughnessAndMetallic => 0..2,
         };
         // Rows from the top (as files store them) to rows from the bottom.
         for y in 0..image.height {
@@ -145,7 +227,9 @@ impl TextureSet {
                             TextureUse::Color => "color",
                             TextureUse::Roughness => "roughness",
                             TextureUse::MetallicRoughness => "metallic-roughness",
+                            TextureUse::RoughnessAndMetallic => "roughness or metallic",
                             TextureUse::Normal => "normal",
+                            TextureUse::Transmission => "transmission",
                         }
                     ));
                 }
@@ -168,8 +252,9 @@ impl TextureSet {
                 self.texels.push(match usage {
                     TextureUse::Color => [r, g, b, image.alpha(x, y)],
                     TextureUse::Normal => [r, g, b, 0.0],
-                    TextureUse::Roughness => [r, 1.0, 1.0, 0.0],
+                    TextureUse::Roughness | TextureUse::Transmission => [r, 1.0, 1.0, 0.0],
                     TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
+                    TextureUse::RoughnessAndMetallic => [r, g, 1.0, 0.0],
                 });
             }
         }
@@ -220,8 +305,10 @@ impl TextureSet {
 fn encoding(usage: TextureUse) -> Encoding {
     match usage {
         TextureUse::Color => Encoding::Srgb,
-        TextureUse::Roughness | TextureUse::MetallicRoughness | TextureUse::Normal => {
-            Encoding::Linear
-        }
+        TextureUse::Roughness
+        | TextureUse::MetallicRoughness
+        | TextureUse::Normal
+        | TextureUse::Transmission
+        | TextureUse::RoughnessAndMetallic => Encoding::Linear,
     }
 }

@@ -6,15 +6,14 @@ use super::camera_control;
 use super::denoised::{DenoisedView, Snapshot, Update};
 use super::display::DisplayPass;
 use super::input::InputState;
-use super::watch::{BackgroundLoad, FileWatch};
+use super::watch::{load_watched, BackgroundLoad, FileWatch, Loaded};
 use super::{ViewOptions, FRAME_TARGET};
 use crate::gpu::{GpuContext, GpuRenderer};
+use crate::input_file::FileRead;
 use crate::output::{Image, ImageFormat};
 use crate::render::{BatchSizer, Renderer};
-use crate::scene::model::load_scene_or_model;
 use crate::scene::{
-    place_camera, Camera, KernelScene, RenderOverrides, Scene, SceneError, MAX_IMAGE_PIXELS,
-    MAX_SPP,
+    place_camera, Camera, KernelScene, RenderOverrides, Scene, MAX_IMAGE_PIXELS, MAX_SPP,
 };
 use crate::shader_types::Params;
 use crate::tonemap::{DisplayTransform, Tonemap};
@@ -40,6 +39,7 @@ pub fn run(
     event_loop: EventLoop<()>,
     scene: Scene,
     kernel: KernelScene,
+    reads: Vec<FileRead>,
     mut options: ViewOptions,
 ) -> Result<()> {
     // Progressive rendering never idles: the image refines while nothing happens.
@@ -47,7 +47,11 @@ pub fn run(
     let script = std::mem::take(&mut options.script);
     let display = options.display;
     let mut app = App {
-        watch: FileWatch::new(&options.scene),
+        watch: {
+            let mut watch = FileWatch::new(&options.scene);
+            watch.adopt(reads, true);
+            watch
+        },
         loader: BackgroundLoad::new(&options.scene).with_model(options.model.clone()),
         sizer: BatchSizer::new(FRAME_TARGET),
         file_camera: scene.camera.clone(),
@@ -433,13 +437,14 @@ impl App {
 
     /// Re-reads the scene file now (scripted reloads; edits go through [`BackgroundLoad`]).
     fn reload(&mut self) -> Result<()> {
-        let loaded = load_scene_or_model(&self.options.scene, &self.options.model);
+        let loaded = load_watched(&self.options.scene, &self.options.model);
         self.apply_loaded(loaded)
     }
 
     /// Adopts a freshly read scene file; a broken file is reported and the last good scene
     /// stays.
-    fn apply_loaded(&mut self, loaded: Result<Scene, SceneError>) -> Result<()> {
+    fn apply_loaded(&mut self, (loaded, reads): Loaded) -> Result<()> {
+        self.watch.adopt(reads, loaded.is_ok());
         let (width, height) = self.image_size();
         let path = self.options.scene.clone();
         let loaded = match loaded {

@@ -17,7 +17,7 @@ pub mod watch;
 
 use crate::error::InputError;
 use crate::output_check::OutputSet;
-use crate::scene::model::{load_scene_or_model, ModelOptions};
+use crate::scene::model::ModelOptions;
 use crate::scene::RenderOverrides;
 use crate::tonemap::DisplayTransform;
 use action::Script;
@@ -67,7 +67,8 @@ fn display_available() -> bool {
 
 /// Runs the viewer until the window closes, Esc, or `frames`.
 pub fn run(options: ViewOptions) -> Result<()> {
-    let scene = load_scene_or_model(&options.scene, &options.model).map_err(InputError::from)?;
+    let (scene, reads) = watch::load_watched(&options.scene, &options.model);
+    let scene = scene.map_err(InputError::from)?;
     let scene = scene
         .with_overrides(&RenderOverrides {
             width: options.width,
@@ -93,5 +94,5 @@ pub fn run(options: ViewOptions) -> Result<()> {
             "no display: glint view cannot connect to the window system ({e}); {NO_DISPLAY_HINT}"
         ))
     })?;
-    app::run(event_loop, scene, kernel, options)
+    app::run(event_loop, scene, kernel, reads, options)
 }

@@ -1,56 +1,81 @@
-//! Notices edits of the scene file by polling its modification time and length: one `stat`
-//! a frame at most, no watcher thread and no new dependency. [`BackgroundLoad`] then reads
-//! the edited file on a worker thread, so the event loop never waits for a file: whatever the
+//! Notices edits of the scene file, and of every file its last load read (meshes, `.mtl` and
+//! `.bin` files, textures, the environment map: `input_file::recording_reads`), by polling
+//! their modification times and lengths: one `stat` per file every [`POLL_INTERVAL`] at most,
+//! no watcher thread and no new dependency. [`BackgroundLoad`] then reads the edited files on
+//! a worker thread, so the event loop never waits for a file: whatever the
 //! file turns into (a FIFO, a link to `/dev/zero`, a huge file, a stalled network mount), the
 //! window keeps drawing.
 
+use crate::input_file::{file_stamp, recording_reads, FileRead, FileStamp};
 use crate::scene::model::{load_scene_or_model, ModelOptions};
 use crate::scene::{Scene, SceneError};
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
-use std::time::{Duration, Instant, SystemTime};
+use std::time::{Duration, Instant};
 
 /// How often the file is looked at; frequent enough to feel instant after a save.
 const POLL_INTERVAL: Duration = Duration::from_millis(100);
 
-/// What identifies one version of the file; `None` while it cannot be read (mid-save).
-type Stamp = Option<(SystemTime, u64)>;
+/// A load's result and the files it read.
+pub type Loaded = (Result<Scene, SceneError>, Vec<FileRead>);
+
+/// Loads the scene (or model) file as the viewer does, recording the files the load read.
+pub fn load_watched(path: &Path, model: &ModelOptions) -> Loaded {
+    recording_reads(|| load_scene_or_model(path, model))
+}
 
 pub struct FileWatch {
-    path: PathBuf,
-    seen: Stamp,
+    /// The scene file first, then what its last load read, each with the version last seen.
+    files: Vec<(PathBuf, FileStamp)>,
     last_poll: Instant,
 }
 
-fn stamp(path: &Path) -> Stamp {
-    let meta = std::fs::metadata(path).ok()?;
-    Some((meta.modified().ok()?, meta.len()))
-}
-
 impl FileWatch {
-    /// Watches `path`, taking its current version as seen.
+    /// Watches the scene file `path`, taking its current version as seen.
     pub fn new(path: &Path) -> FileWatch {
         FileWatch {
-            path: path.to_owned(),
-            seen: stamp(path),
+            files: vec![(path.to_owned(), file_stamp(path))],
             last_poll: Instant::now(),
         }
     }
 
-    /// Whether the file changed since the last call that said so; polls at most every
+    /// Watches what a load read, at the versions it read. After a good load these are the
+    /// files; after a failed one they join the files watched (the last good scene's stay, and
+    /// the file that broke the load is watched for its fix).
+    pub fn adopt(&mut self, reads: Vec<FileRead>, load_succeeded: bool) {
+        if load_succeeded {
+            self.files.truncate(1);
+        }
+        for (path, stamp) in reads {
+            match self.files.iter_mut().find(|(p, _)| *p == path) {
+                Some(file) => file.1 = stamp,
+                None => self.files.push((path, stamp)),
+            }
+        }
+    }
+
+    /// Whether a watched file changed since the last call that said so; polls at most every
     /// [`POLL_INTERVAL`] unless `now` is set.
     pub fn changed(&mut self, now: bool) -> bool {
         if !now && self.last_poll.elapsed() < POLL_INTERVAL {
             return false;
         }
         self.last_poll = Instant::now();
-        let current = stamp(&self.path);
-        // A file that vanished (an editor's rename dance) is reported when it is back.
-        if current.is_none() || current == self.seen {
-            return false;
+        let mut changed = false;
+        for (path, seen) in &mut self.files {
+            let current = file_stamp(path);
+            // A file that vanished (an editor's rename dance) is reported when it is back.
+            if current.is_some() && current != *seen {
+                *seen = current;
+                changed = true;
+            }
         }
-        self.seen = current;
-        true
+        changed
+    }
+
+    /// How many files are watched (the scene file included).
+    pub fn file_count(&self) -> usize {
+        self.files.len()
     }
 }
 
@@ -59,7 +84,7 @@ pub struct BackgroundLoad {
     path: PathBuf,
     /// How a model file becomes a scene (a scene file ignores it).
     model: ModelOptions,
-    in_flight: Option<Receiver<Result<Scene, SceneError>>>,
+    in_flight: Option<Receiver<Loaded>>,
     /// Another edit came while a load was in flight: load again when it is done.
     wanted: bool,
 }
@@ -96,23 +121,26 @@ impl BackgroundLoad {
         let model = self.model.clone();
         std::thread::spawn(move || {
             // The viewer may have moved on (or quit) by the time the load ends.
-            let _ = send.send(load_scene_or_model(&path, &model));
+            let _ = send.send(load_watched(&path, &model));
         });
         self.in_flight = Some(receive);
     }
 
     /// The result of the load in flight, once it is done; never waits.
-    pub fn poll(&mut self) -> Option<Result<Scene, SceneError>> {
+    pub fn poll(&mut self) -> Option<Loaded> {
         let receiver = self.in_flight.as_ref()?;
         let result = match receiver.try_recv() {
             Ok(result) => result,
             Err(TryRecvError::Empty) => return None,
-            Err(TryRecvError::Disconnected) => Err(SceneError {
-                path: self.path.clone(),
-                position: None,
-                field: None,
-                message: "the scene loader stopped unexpectedly".into(),
-            }),
+            Err(TryRecvError::Disconnected) => (
+                Err(SceneError {
+                    path: self.path.clone(),
+                    position: None,
+                    field: None,
+                    message: "the scene loader stopped unexpectedly".into(),
+                }),
+                Vec::new(),
+            ),
         };
         self.in_flight = None;
         self.start_if_idle();
@@ -145,6 +173,46 @@ mod tests {
         assert!(w.changed(true));
     }
 
+    /// The files a load read are watched with the scene file: an edited texture is an edit,
+    /// also after a load that failed on it.
+    #[test]
+    fn an_edited_texture_is_an_edit_of_the_scene() {
+        let dir = tempfile::tempdir().unwrap();
+        let scene = dir.path().join("s.toml");
+        let texture = dir.path().join("t.png");
+        std::fs::write(
+            &scene,
+            "[camera]\neye = [0, 0, -5]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\n\
+             [render]\nwidth = 4\nheight = 4\nspp = 1\nmax_bounces = 1\n\
+             [materials.m]\ntype = \"diffuse\"\ncolor = { texture = \"t.png\" }\n\
+             [[spheres]]\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n",
+        )
+        .unwrap();
+        let write_png = |grey: u8| {
+            image::GrayImage::from_pixel(2, 2, image::Luma([grey]))
+                .save(&texture)
+                .unwrap()
+        };
+        write_png(100);
+        let mut w = FileWatch::new(&scene);
+        let (result, reads) = load_watched(&scene, &ModelOptions::default());
+        result.unwrap();
+        assert_eq!(reads.len(), 2, "{reads:?}");
+        w.adopt(reads, true);
+        assert_eq!(w.file_count(), 2);
+        assert!(!w.changed(true));
+        // File times can be coarse: a new length is a new version whatever the clock says.
+        std::fs::write(&texture, b"not an image").unwrap();
+        assert!(w.changed(true));
+        assert!(!w.changed(true));
+        // The broken texture fails the load; its fix is an edit too.
+        let (result, reads) = load_watched(&scene, &ModelOptions::default());
+        assert!(result.is_err());
+        w.adopt(reads, false);
+        write_png(200);
+        assert!(w.changed(true));
+    }
+
     /// A FIFO with no writer would block a plain open() for ever; the load must fail at once.
     #[cfg(unix)]
     #[test]
@@ -163,7 +231,7 @@ mod tests {
             assert!(Instant::now() < deadline, "the load of a FIFO did not end");
             std::thread::sleep(Duration::from_millis(5));
         };
-        let e = result.unwrap_err().to_string();
+        let e = result.0.unwrap_err().to_string();
         assert!(e.contains("FIFO"), "{e}");
         assert!(!load.busy());
     }

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 
 /// Number of χ² tests in the whole suite (tests/chi2.rs), for the Šidák correction. Keep it
 /// in step when tests are added.
-pub const CHI2_TESTS_IN_SUITE: u32 = 54;
+pub const CHI2_TESTS_IN_SUITE: u32 = 79;
 
 /// Per-test significance such that the whole suite wrongly fails with probability 0.01.
 pub fn sidak_alpha() -> f64 {
@@ -104,6 +104,28 @@ pub fn directions_integrated(
     phi_bins: usize,
     steps: usize,
 ) -> Result<Chi2, String> {
+    let (observed, expected) = binned(
+        samples,
+        samples.len() as u64,
+        axis,
+        &pdf,
+        cos_bins,
+        phi_bins,
+        steps,
+    )?;
+    Ok(pearson(&observed, &expected))
+}
+
+/// The samples' counts per (cos θ, φ) cell, and what `total` samples drawn with `pdf` expect.
+fn binned(
+    samples: &[Vec3],
+    total: u64,
+    axis: Vec3,
+    pdf: &impl Fn(Vec3) -> f64,
+    cos_bins: usize,
+    phi_bins: usize,
+    steps: usize,
+) -> Result<(Vec<u64>, Vec<f64>), String> {
     let (t, b) = axis.any_orthonormal_pair();
     let (t, b, n) = (t.as_dvec3(), b.as_dvec3(), axis.as_dvec3());
     let mut observed = vec![0u64; cos_bins * phi_bins];
@@ -139,9 +161,29 @@ pub fn directions_integrated(
                 2.0 * PI * (j + 1) as f64 / phi_bins as f64,
             );
             expected[i * phi_bins + j] =
-                samples.len() as f64 * midpoint_2d(&density, c0, c1, p0, p1, steps);
+                total as f64 * midpoint_2d(&density, c0, c1, p0, p1, steps);
         }
     }
+    Ok((observed, expected))
+}
+
+/// [`directions_integrated`] for a sampler that absorbs some of its samples (a reflection below
+/// the surface, a refraction above it): `pdf` is the density of the kept samples, integrating
+/// to less than 1, and the `absorbed` ones fill one more cell, which expects the rest.
+pub fn directions_with_absorbed(
+    kept: &[Vec3],
+    absorbed: u64,
+    axis: Vec3,
+    pdf: impl Fn(Vec3) -> f64,
+    cos_bins: usize,
+    phi_bins: usize,
+    steps: usize,
+) -> Result<Chi2, String> {
+    let total = kept.len() as u64 + absorbed;
+    let (mut observed, mut expected) = binned(kept, total, axis, &pdf, cos_bins, phi_bins, steps)?;
+    let kept_mass: f64 = expected.iter().sum();
+    observed.push(absorbed);
+    expected.push((total as f64 - kept_mass).max(0.0));
     Ok(pearson(&observed, &expected))
 }
 

@@ -23,7 +23,9 @@ pub struct ProbeParams {
     pub side_probe: [f32; 3],
     pub ior: f32,
     pub front_face: u32,
-    pub _pad: [u32; 3],
+    /// The pbr material's transmission (probe_pbr).
+    pub transmission: f32,
+    pub _pad: [u32; 2],
 }
 
 pub const PROBE_SOURCE: &str = include_str!("../shaders/probe.wgsl");

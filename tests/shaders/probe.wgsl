@@ -13,6 +13,8 @@ struct ProbeParams {
     side_probe: vec3<f32>,
     ior: f32,
     front_face: u32,
+    // The pbr material's transmission (probe_pbr).
+    transmission: f32,
 }
 
 @group(0) @binding(10) var<uniform> probe: ProbeParams;
@@ -70,6 +72,21 @@ fn probe_metal(@builtin(global_invocation_id) id: vec3<u32>) {
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
 
+// A white dielectric pbr material (metallic 0, specular 1) with probe.transmission.
+@compute @workgroup_size(256, 1, 1)
+fn probe_pbr(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var m = probe_material(MATERIAL_PBR);
+    m.specular = 1.0;
+    m.specular_color = vec3<f32>(1.0);
+    m.transmission = probe.transmission;
+    let s = bsdf_sample(m, probe.wo, probe.normal, probe.front_face != 0u, &rng);
+    probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
+}
+
 @compute @workgroup_size(256, 1, 1)
 fn probe_dielectric(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
@@ -118,14 +135,14 @@ fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // The material at a hit: material probe.seed of the bound scene at the texture coordinates of
 // triangle_uvs[id / 2].uv0 (tests/gltf_materials.rs fills them); even entries write albedo
-// and alpha, odd ones metallic.
+// and alpha, odd ones metallic and transmission.
 @compute @workgroup_size(256, 1, 1)
 fn probe_material_at(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
     let m = material_at(materials[probe.seed], triangle_uv(id.x / 2u, vec3<f32>(1.0, 0.0, 0.0)));
-    probe_out[id.x] = select(vec4<f32>(m.metallic, 0.0, 0.0, 0.0), vec4<f32>(m.albedo, m.alpha), id.x % 2u == 0u);
+    probe_out[id.x] = select(vec4<f32>(m.metallic, m.transmission, 0.0, 0.0), vec4<f32>(m.albedo, m.alpha), id.x % 2u == 0u);
 }
 
 // The emitter choice alone (pick_emitter, from the draws sample_light makes first): the

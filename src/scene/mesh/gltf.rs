@@ -38,14 +38,19 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_transmission",
+    "KHR_materials_volume",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
 ];
 
 /// Extensions glint reads entirely; any other the file uses gets a warning.
+/// (KHR_materials_volume's thicknessFactor and thicknessTexture are for rasterisers, which
+/// cannot trace the ray through the mesh: glint does, and ignores them.)
 const FULLY_READ_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
 ];
@@ -106,10 +111,12 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
             color: source(maps.color)?,
             metallic_roughness: source(maps.metallic_roughness)?,
             emission: source(maps.emission)?,
+            transmission: source(maps.transmission)?,
             normal: match maps.normal {
                 Some((image, scale)) => source(Some(image))?.map(|s| (s, scale)),
                 None => None,
             },
+            roughness_and_metallic: None,
         });
         materials.push(material);
         has_other_textures |= other_textures;
@@ -392,9 +399,9 @@ fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
 
 /// A glTF material as glint's, its colour texture's file, and whether it has other textures:
 /// `pbrMetallicRoughness` (baseColorFactor, metallicFactor, roughnessFactor, with glTF's
-/// defaults), KHR_materials_ior and KHR_materials_specular's factors → `pbr`;
-/// KHR_materials_transmission > 0 → dielectric with the ior (glint has no rough or partly
-/// transmissive dielectric yet: a warning says so); emissiveFactor ×
+/// defaults), KHR_materials_ior and KHR_materials_specular's factors,
+/// KHR_materials_transmission (factor and texture) and KHR_materials_volume
+/// (attenuationColor, attenuationDistance) → `pbr`; emissiveFactor ×
 /// KHR_materials_emissive_strength → emission; alphaMode, alphaCutoff and baseColorFactor's
 /// alpha → alpha. Warning lines go to `warnings`.
 fn material(
@@ -406,9 +413,8 @@ fn material(
     let name = format!("material{index}");
     let extensions = m.extensions.as_ref();
     let pbr = &m.pbr_metallic_roughness;
-    let transmission = extensions
-        .and_then(|e| e.transmission.as_ref())
-        .map(|t| t.transmission_factor.0);
+    let transmission = extensions.and_then(|e| e.transmission.as_ref());
+    let volume = extensions.and_then(|e| e.volume.as_ref());
     // glTF's ior 0 is a special case glint cannot render; its default is 1.5.
     let ior = extensions
         .and_then(|e| e.ior.as_ref())
@@ -416,14 +422,7 @@ fn material(
         .filter(|&n| n > 0.0)
         .unwrap_or(1.5);
     let ior = check_ior(&name, "KHR_materials_ior", ior)?;
-    let kind = if let Some(t) = transmission.filter(|&t| t > 0.0) {
-        warnings.push(format!(
-            "materials[{index}]: KHR_materials_transmission {t} is rendered as a smooth, fully \
-             transmissive dielectric (ior {ior}); glint has no rough or partly transmissive one \
-             yet"
-        ));
-        MaterialKind::Dielectric { ior }
-    } else {
+    let kind = {
         let unit = |what: &str, v: f32| {
             if (0.0..=1.0).contains(&v) {
                 Ok(v)
@@ -441,6 +440,23 @@ fn material(
                  {specular_color}"
             ));
         }
+        let attenuation_color = check_reflectance(
+            &name,
+            "KHR_materials_volume attenuationColor",
+            Vec3::from(volume.map_or([1.0; 3], |v| v.attenuation_color.0)),
+        )?;
+        // Absent is glTF's +∞: no attenuation. (JSON has no ∞, so any number given is finite.)
+        let attenuation_distance = match volume.map(|v| v.attenuation_distance.0) {
+            Some(d) if d.is_infinite() && d > 0.0 => None,
+            Some(d) if d > 0.0 && d.is_finite() => Some(d),
+            Some(d) => {
+                return Err(format!(
+                    "material {name:?}: KHR_materials_volume attenuationDistance must be > 0, got \
+                     {d}"
+                ))
+            }
+            None => None,
+        };
         MaterialKind::Pbr {
             roughness: unit("roughnessFactor", pbr.roughness_factor.0)?,
             metallic: unit("metallicFactor", pbr.metallic_factor.0)?,
@@ -450,6 +466,13 @@ fn material(
                 specular.map_or(1.0, |s| s.specular_factor.0),
             )?,
             specular_color,
+            transmission: unit(
+                "KHR_materials_transmission transmissionFactor",
+                transmission.map_or(0.0, |t| t.transmission_factor.0),
+            )?,
+            transmission_texture: None,
+            attenuation_color,
+            attenuation_distance,
         }
     };
     let color = check_reflectance(
@@ -553,6 +576,13 @@ fn material(
         } else {
             image(&m.emissive_texture, "emissiveTexture")?
         },
+        transmission: match transmission {
+            Some(t) => image(
+                &t.transmission_texture,
+                "extensions.KHR_materials_transmission.transmissionTexture",
+            )?,
+            None => None,
+        },
         normal: match &m.normal_texture {
             Some(n) => {
                 let field = format!("materials[{index}].normalTexture");
@@ -641,6 +671,8 @@ struct MaterialImages {
     color: Option<(usize, Sampling)>,
     metallic_roughness: Option<(usize, Sampling)>,
     emission: Option<(usize, Sampling)>,
+    /// KHR_materials_transmission's transmissionTexture (R multiplies the factor).
+    transmission: Option<(usize, Sampling)>,
     /// The normal map and its scale.
     normal: Option<((usize, Sampling), f32)>,
 }

@@ -20,7 +20,7 @@ pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{Sampling, TextureSet, TextureUse};
-use super::{Material, Triangle};
+use super::{Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -130,8 +130,13 @@ pub(super) struct FileTextures {
     metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `emissiveTexture` (sRGB), multiplying the emission.
     emission: Option<(Rc<ImageSource>, Sampling)>,
+    /// KHR_materials_transmission's `transmissionTexture` (linear): red multiplies the
+    /// transmission factor.
+    transmission: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `normalTexture` (linear), and its scale.
     normal: Option<((Rc<ImageSource>, Sampling), f32)>,
+    /// OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, merged on load.
+    roughness_and_metallic: Option<(Option<PathBuf>, Option<PathBuf>)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -251,9 +256,27 @@ pub(crate) fn load(
                         m.roughness_texture =
                             load(&maps.metallic_roughness, TextureUse::MetallicRoughness)?;
                         m.emission_texture = load(&maps.emission, TextureUse::Color)?;
+                        if let MaterialKind::Pbr {
+                            transmission_texture,
+                            ..
+                        } = &mut m.kind
+                        {
+                            *transmission_texture =
+                                load(&maps.transmission, TextureUse::Transmission)?;
+                        }
                         if let Some((map, scale)) = &maps.normal {
                             m.normal_texture =
                                 load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
+                        }
+                        if let Some((roughness, metallic)) = &maps.roughness_and_metallic {
+                            m.roughness_texture = Some(
+                                textures
+                                    .roughness_and_metallic(
+                                        roughness.as_deref(),
+                                        metallic.as_deref(),
+                                    )
+                                    .map_err(|e| format!("material {name:?}: {e}"))?,
+                            );
                         }
                         m.name = format!("{stem}/{}", m.name);
                         let id = scene_materials.len() as u32;

@@ -41,15 +41,102 @@ impl<R: BufRead> BufRead for LineCounter<R> {
     }
 }
 
-/// OBJ `.mtl`: Kd → diffuse colour, Ke → emission, d < 1 → dielectric with Ni (default 1.5),
-/// illum 3 or 5 → mirror with Ks (else Kd).
-fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
-    // map_Kd is used (see read_obj); the other maps are not.
+/// OBJ `.mtl` statements of the PBR extension (as Blender writes them) that make a material
+/// glint's `pbr`.
+const PBR_STATEMENTS: &[&str] = &["Pr", "Pm", "map_Pr", "map_Pm"];
+
+/// PBR-extension statements glint does not read: each gets a warning.
+const UNREAD_PBR_STATEMENTS: &[&str] = &[
+    "Ps",
+    "Pc",
+    "Pcr",
+    "aniso",
+    "anisor",
+    "map_Ps",
+    "map_Pc",
+    "map_Pcr",
+    "map_aniso",
+];
+
+/// One `.mtl` material as glint's, its texture maps, and warning lines (without the file):
+/// - `Pr`/`Pm`/`map_Pr`/`map_Pm` present → `pbr` with Kd, roughness `Pr` (else from `Ns` as
+///   Blender's importer derives it, 1 − √(Ns/1000)), metallic `Pm` and ior `Ni`;
+/// - else d < 1 → dielectric with Ni (default 1.5); illum 3 or 5 → mirror with Ks (else Kd);
+///   else diffuse Kd;
+/// - Ke → emission, with `map_Ke` multiplying it (Ke 1 when only the map is given);
+/// - `map_Kd` multiplies a diffuse or pbr colour; `norm`, `map_Bump` or `bump` is a
+///   tangent-space normal map, its `-bm` option the scale (Blender's importer reads these as
+///   normal maps too).
+fn obj_material(
+    m: &tobj::Material,
+    dir: &Path,
+) -> Result<(Material, FileTextures, bool, Vec<String>), String> {
     let name = &m.name;
+    let mut warnings = Vec::new();
+    let param = |key: &str| m.unknown_param.get(key).map(|v| v.trim());
+    let number = |key: &str| {
+        param(key)
+            .map(|v| {
+                v.parse::<f32>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| format!("material {name:?}: {key}: not a number: {v:?}"))
+            })
+            .transpose()
+    };
+    let unit = |key: &str, v: f32| {
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!(
+                "material {name:?}: {key} must be in [0, 1], got {v}"
+            ))
+        }
+    };
+    let map = |value: Option<&str>, key: &str| {
+        value
+            .map(|v| {
+                map_statement(v)
+                    .map(|(file, scale)| (dir.join(file), scale))
+                    .ok_or_else(|| format!("material {name:?}: {key}: no image file named"))
+            })
+            .transpose()
+    };
     let kd = Vec3::from(m.diffuse.unwrap_or([0.8; 3]));
-    let emission = check_emission(name, "Ke", Vec3::from(m.emissive.unwrap_or([0.0; 3])))?;
-    let kind = if m.dissolve.is_some_and(|d| d < 1.0) {
-        let ior = m.optical_density.filter(|&n| n > 0.0).unwrap_or(1.5);
+    let map_ke = map(param("map_Ke"), "map_Ke")?;
+    let ke = m.emissive.map(Vec3::from).unwrap_or(if map_ke.is_some() {
+        Vec3::ONE
+    } else {
+        Vec3::ZERO
+    });
+    let emission = check_emission(name, "Ke", ke)?;
+    let is_pbr = PBR_STATEMENTS.iter().any(|k| param(k).is_some());
+    let ior = m.optical_density.filter(|&n| n > 0.0).unwrap_or(1.5);
+    let kind = if is_pbr {
+        let roughness = match number("Pr")? {
+            Some(r) => unit("Pr", r)?,
+            None => m
+                .shininess
+                .map_or(0.5, |ns| 1.0 - (ns.clamp(0.0, 1000.0) / 1000.0).sqrt()),
+        };
+        if m.dissolve.is_some_and(|d| d < 1.0) {
+            warnings.push(format!(
+                "material {name:?}: d (opacity) {} is ignored: a pbr material is opaque",
+                m.dissolve.unwrap_or(1.0)
+            ));
+        }
+        MaterialKind::Pbr {
+            roughness,
+            metallic: unit("Pm", number("Pm")?.unwrap_or(0.0))?,
+            ior: check_ior(name, "Ni", ior)?,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+            transmission: 0.0,
+            transmission_texture: None,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: None,
+        }
+    } else if m.dissolve.is_some_and(|d| d < 1.0) {
         MaterialKind::Dielectric {
             ior: check_ior(name, "Ni", ior)?,
         }
@@ -58,6 +145,17 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
     } else {
         MaterialKind::Diffuse
     };
+    let unread: Vec<&str> = UNREAD_PBR_STATEMENTS
+        .iter()
+        .copied()
+        .filter(|k| param(k).is_some())
+        .collect();
+    if !unread.is_empty() {
+        warnings.push(format!(
+            "material {name:?}: {} (sheen, clearcoat, anisotropy) not read; ignored",
+            unread.join(", ")
+        ));
+    }
     let color = match kind {
         MaterialKind::Specular => {
             check_reflectance(name, "Ks", Vec3::from(m.specular.unwrap_or(kd.to_array())))?
@@ -65,32 +163,109 @@ fn obj_material(m: &tobj::Material) -> Result<(Material, bool), String> {
         MaterialKind::Dielectric { .. } => Vec3::ONE,
         _ => check_reflectance(name, "Kd", kd)?,
     };
-    let textures = [
+    let mut maps = FileTextures::default();
+    let mut material = Material {
+        name: name.clone(),
+        kind,
+        color,
+        emitted_radiance: emission,
+        color_texture: None,
+        roughness_texture: None,
+        emission_texture: None,
+        normal_texture: None,
+        alpha: crate::scene::Alpha::OPAQUE,
+    };
+    let mut other_textures = false;
+    // map_Kd is the diffuse or base colour: mirrors (Ks) and glass (clear) do not use it.
+    if let Some((file, _)) = map(m.diffuse_texture.as_deref(), "map_Kd")? {
+        if matches!(kind, MaterialKind::Diffuse | MaterialKind::Pbr { .. }) {
+            // map_Kd replaces Kd (the kernel multiplies the colour by the texture).
+            material.color = Vec3::ONE;
+            maps.color = Some((Rc::new(ImageSource::File(file)), Default::default()));
+        } else {
+            other_textures = true;
+        }
+    }
+    let map_pr = map(param("map_Pr"), "map_Pr")?.map(|(f, _)| f);
+    let map_pm = map(param("map_Pm"), "map_Pm")?.map(|(f, _)| f);
+    if map_pr.is_some() || map_pm.is_some() {
+        maps.roughness_and_metallic = Some((map_pr, map_pm));
+    }
+    if let Some((file, _)) = map_ke {
+        maps.emission = Some((Rc::new(ImageSource::File(file)), Default::default()));
+    }
+    // tobj files `map_Bump` and `bump` as its normal texture; `norm` is the PBR extension's.
+    let (normal_key, normal) = match param("norm") {
+        Some(v) => ("norm", Some(v)),
+        None => ("map_Bump", m.normal_texture.as_deref()),
+    };
+    if let Some((file, scale)) = map(normal, normal_key)? {
+        let scale = scale.unwrap_or(1.0);
+        if !scale.is_finite() {
+            return Err(format!(
+                "material {name:?}: {normal_key}: -bm is not finite"
+            ));
+        }
+        maps.normal = Some((
+            (Rc::new(ImageSource::File(file)), Default::default()),
+            scale,
+        ));
+    }
+    other_textures |= [
         &m.ambient_texture,
         &m.specular_texture,
-        &m.normal_texture,
         &m.shininess_texture,
         &m.dissolve_texture,
     ]
     .iter()
     .any(|t| t.is_some())
-        || m.unknown_param
-            .keys()
-            .any(|k| k.starts_with("map_") || k == "bump" || k == "disp");
-    Ok((
-        Material {
-            name: name.clone(),
-            kind,
-            color,
-            emitted_radiance: emission,
-            color_texture: None,
-            roughness_texture: None,
-            emission_texture: None,
-            normal_texture: None,
-            alpha: crate::scene::Alpha::OPAQUE,
-        },
-        textures,
-    ))
+        || m.unknown_param.keys().any(|k| {
+            (k.starts_with("map_") || k == "disp" || k == "refl")
+                && !matches!(k.as_str(), "map_Pr" | "map_Pm" | "map_Ke")
+                && !UNREAD_PBR_STATEMENTS.contains(&k.as_str())
+        });
+    Ok((material, maps, other_textures, warnings))
+}
+
+/// The image file of an `.mtl` map statement's value and its `-bm` (bump multiplier): the
+/// options before the file name (`-s 1 1 1`, `-bm 0.5`, `-clamp on`, ...) are read past, each
+/// with its arguments; what follows is the file name, spaces included. `None` when no file
+/// name is left.
+fn map_statement(value: &str) -> Option<(String, Option<f32>)> {
+    let mut rest = value.trim();
+    let mut bump_multiplier = None;
+    let next_word = |s: &str| {
+        let s = s.trim_start();
+        let end = s.find(char::is_whitespace).unwrap_or(s.len());
+        (s[..end].to_string(), s[end..].trim_start().to_string())
+    };
+    while rest.starts_with('-') {
+        let (option, after) = next_word(rest);
+        let mut after = after;
+        // -o, -s and -t take one to three numbers; the others a fixed count.
+        let (least, most) = match option.as_str() {
+            "-o" | "-s" | "-t" => (1, 3),
+            "-mm" => (2, 2),
+            "-blendu" | "-blendv" | "-bm" | "-boost" | "-cc" | "-clamp" | "-imfchan"
+            | "-texres" | "-type" => (1, 1),
+            _ => (0, 0),
+        };
+        let mut arguments = Vec::new();
+        while arguments.len() < most {
+            let (word, later) = next_word(&after);
+            let numeric = word.parse::<f32>().is_ok();
+            if word.is_empty() || (arguments.len() >= least && !numeric) {
+                break;
+            }
+            arguments.push(word);
+            after = later;
+        }
+        if option == "-bm" {
+            bump_multiplier = arguments.first().and_then(|a| a.parse::<f32>().ok());
+        }
+        rest = value[value.len() - after.len()..].trim();
+    }
+    (!rest.is_empty()).then(|| (rest.to_string(), bump_multiplier))
 }
 
 pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
@@ -118,22 +293,13 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
     let mut has_other_textures = false;
     let mut converted = Vec::new();
     let mut file_textures = Vec::new();
+    let mut warnings = Vec::new();
     for m in &materials {
-        let (mut material, textures) = obj_material(m)?;
-        // map_Kd is the diffuse colour: mirrors (Ks) and glass (clear) do not use it. Relative
-        // to the OBJ's folder, as tobj reads the .mtl from there.
-        let map_kd = m.diffuse_texture.as_ref().map(|t| dir.join(t.trim()));
-        let diffuse = material.kind == MaterialKind::Diffuse;
-        has_other_textures |= textures || (map_kd.is_some() && !diffuse);
-        let map_kd = map_kd.filter(|_| diffuse);
-        if map_kd.is_some() {
-            // map_Kd replaces Kd (the kernel multiplies the colour by the texture).
-            material.color = Vec3::ONE;
-        }
-        file_textures.push(FileTextures {
-            color: map_kd.map(|path| (Rc::new(ImageSource::File(path)), Default::default())),
-            ..Default::default()
-        });
+        // Relative to the OBJ's folder, as tobj reads the .mtl from there.
+        let (material, maps, other_textures, material_warnings) = obj_material(m, &dir)?;
+        has_other_textures |= other_textures;
+        warnings.extend(material_warnings);
+        file_textures.push(maps);
         converted.push(material);
     }
     let parts = models
@@ -166,7 +332,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
         materials: converted,
         textures: file_textures,
         has_other_textures,
-        warnings: Vec::new(),
+        warnings,
     })
 }
 

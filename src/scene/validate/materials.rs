@@ -148,12 +148,44 @@ pub(super) fn validate_materials(
                     Some(c) => non_negative(c, &field("specular_color"))?,
                     None => Vec3::ONE,
                 };
+                let attenuation_color = match &m.attenuation_color {
+                    Some(c) => {
+                        let color = non_negative(c, &field("attenuation_color"))?;
+                        if color.max_element() > 1.0 {
+                            return fail(
+                                c.span(),
+                                field("attenuation_color"),
+                                format!("must be in [0, 1] (a fraction of the light that remains), got {color}"),
+                            );
+                        }
+                        color
+                    }
+                    None => Vec3::ONE,
+                };
+                let attenuation_distance = match &m.attenuation_distance {
+                    Some(d) => {
+                        let v = real(d, &field("attenuation_distance"))?;
+                        if v <= 0.0 {
+                            return fail(
+                                d.span(),
+                                field("attenuation_distance"),
+                                format!("must be > 0 (leave it out for no attenuation), got {v}"),
+                            );
+                        }
+                        Some(v)
+                    }
+                    None => None,
+                };
                 MaterialKind::Pbr {
                     roughness,
                     metallic: unit(&m.metallic, "metallic", 0.0)?,
                     ior: m.ior.as_ref().map_or(Ok(1.5), ior_in_range)?,
                     specular: unit(&m.specular, "specular", 1.0)?,
                     specular_color,
+                    transmission: unit(&m.transmission, "transmission", 0.0)?,
+                    transmission_texture: None,
+                    attenuation_color,
+                    attenuation_distance,
                 }
             }
             other => {
@@ -193,6 +225,21 @@ pub(super) fn validate_materials(
             (
                 m.specular_color.as_ref().map(|r| r.span()),
                 "specular_color",
+                pbr,
+            ),
+            (
+                m.transmission.as_ref().map(|r| r.span()),
+                "transmission",
+                pbr,
+            ),
+            (
+                m.attenuation_color.as_ref().map(|r| r.span()),
+                "attenuation_color",
+                pbr,
+            ),
+            (
+                m.attenuation_distance.as_ref().map(|r| r.span()),
+                "attenuation_distance",
                 pbr,
             ),
         ] {

@@ -1,0 +1,61 @@
+# Renders a glTF file with Cycles as glint's helmet comparison does: glint's camera (eye on +z
+# in glTF's Y-up frame, looking at the origin, vertical field of view), an equirectangular
+# environment map turned to glint's orientation, the same bounces, a near-box pixel filter,
+# linear EXR out. Usage: blender -b --python render.py -- MODEL ENV OUT.exr SIZE SPP EYE_Z VFOV
+import bpy, math, sys
+import numpy
+# Debian 12 Blender 3.4 glTF importer uses np.bool, which newer NumPy removed.
+if not hasattr(numpy, "bool") or numpy.bool is not bool:
+    numpy.bool = bool
+argv = sys.argv[sys.argv.index("--") + 1:]
+model, env, out, size, spp, eye_z, vfov = argv[0], argv[1], argv[2], int(argv[3]), int(argv[4]), float(argv[5]), float(argv[6])
+bpy.ops.wm.read_factory_settings(use_empty=True)
+bpy.ops.import_scene.gltf(filepath=model)
+scene = bpy.context.scene
+# glTF (x, y, z) is Blender (x, -z, y): glint's eye (0, 0, eye_z) is Blender (0, -eye_z, 0).
+cam_data = bpy.data.cameras.new("cam")
+cam_data.sensor_fit = 'VERTICAL'
+cam_data.angle_y = math.radians(vfov)
+cam = bpy.data.objects.new("cam", cam_data)
+cam.location = (0.0, -eye_z, 0.0)
+cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
+scene.collection.objects.link(cam)
+scene.camera = cam
+world = bpy.data.worlds.new("world")
+world.use_nodes = True
+scene.world = world
+nodes, links = world.node_tree.nodes, world.node_tree.links
+background = nodes["Background"]
+texture = nodes.new("ShaderNodeTexEnvironment")
+texture.image = bpy.data.images.load(env)
+texture.interpolation = 'Closest'  # glint reads the nearest texel
+coords = nodes.new("ShaderNodeTexCoord")
+mapping = nodes.new("ShaderNodeMapping")
+# glint reads u = atan2(x, -z) / 2π (glTF frame); Cycles u = (π − atan2(y, x)) / 2π (its frame)
+# is glint's + 0.25 there: turn the lookup direction +90° about +Z.
+mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(90.0))
+links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+links.new(texture.outputs["Color"], background.inputs["Color"])
+scene.render.engine = 'CYCLES'
+cycles = scene.cycles
+cycles.device = 'CPU'
+cycles.samples = spp
+cycles.use_adaptive_sampling = False
+cycles.use_denoising = False
+cycles.max_bounces = 8
+cycles.diffuse_bounces = cycles.glossy_bounces = cycles.transmission_bounces = 8
+cycles.volume_bounces = 0
+cycles.transparent_max_bounces = 8
+cycles.sample_clamp_direct = cycles.sample_clamp_indirect = 0.0
+cycles.caustics_reflective = cycles.caustics_refractive = True
+cycles.blur_glossy = 0.0
+cycles.filter_width = 0.01
+cycles.seed = 1
+scene.render.resolution_x = scene.render.resolution_y = size
+scene.render.resolution_percentage = 100
+scene.view_settings.view_transform = 'Standard'
+scene.render.image_settings.file_format = 'OPEN_EXR'
+scene.render.image_settings.color_depth = '32'
+scene.render.filepath = out
+bpy.ops.render.render(write_still=True)
