@@ -738,4 +738,28 @@ fn the_base_color_textures_alpha_is_kept_linear() {
             );
         }
     }
+
+/// KHR_materials_unlit: the surface emits its base colour and reflects nothing; the file's
+/// other factors (metal, roughness, emission) do not apply; the extension is fully read (no
+/// warning).
+#[test]
+fn unlit_materials_emit_their_base_colour() {
+    let material = serde_json::json!({
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [0.2, 0.4, 0.6, 1.0],
+            "metallicFactor": 1.0,
+            "roughnessFactor": 0.3
+        },
+        "emissiveFactor": [1.0, 1.0, 1.0],
+        "extensions": {"KHR_materials_unlit": {}}
+    });
+    let m = loaded_material(material.clone());
+    assert_eq!(m.kind, glint::scene::MaterialKind::Diffuse);
+    assert_eq!(m.color, glam::Vec3::ZERO);
+    assert_eq!(m.emitted_radiance, glam::Vec3::new(0.2, 0.4, 0.6));
+    assert_eq!(m.emission_texture, None);
+    let (mut json, bin) = triangle_gltf(material);
+    json["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit"]);
+    json["extensionsRequired"] = serde_json::json!(["KHR_materials_unlit"]);
+    assert_eq!(render_warnings(&json, &bin), Vec::<String>::new());
 }

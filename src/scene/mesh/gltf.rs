@@ -38,6 +38,7 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_transmission",
+    "KHR_materials_unlit",
     "KHR_materials_volume",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
@@ -50,6 +51,7 @@ const FULLY_READ_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_materials_transmission",
+    "KHR_materials_unlit",
     "KHR_materials_volume",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
@@ -616,6 +618,34 @@ fn material(
     if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
         other_textures |=
             specular.specular_texture.is_some() || specular.specular_color_texture.is_some();
+    }
+    // KHR_materials_unlit: the surface shows its base colour whatever lights it. A path tracer
+    // has no unlit surface: it emits its base colour (× the colour texture) and reflects
+    // nothing, so the camera sees the colour as authored, and what is near it gets that light
+    // too, as from a lamp of that colour.
+    if extensions.is_some_and(|e| e.unlit.is_some()) {
+        return Ok((
+            Material {
+                name,
+                kind: MaterialKind::Diffuse,
+                color: Vec3::ZERO,
+                emitted_radiance: color,
+                color_texture: None,
+                roughness_texture: None,
+                emission_texture: None,
+                normal_texture: None,
+                alpha,
+            },
+            MaterialImages {
+                // The colour texture stays for its alpha (× black, it adds no colour).
+                emission: maps.color,
+                color: maps.color,
+                metallic_roughness: None,
+                transmission: None,
+                normal: None,
+            },
+            other_textures,
+        ));
     }
     Ok((
         Material {
