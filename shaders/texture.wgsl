@@ -7,7 +7,8 @@
 // so it would break "GPU and CPU trace the same paths". Compiled in only when a material uses
 // a texture (HAS_TEXTURES, src/shader.rs).
 
-// Every texture's descriptor, and all images' texels (linear RGB; w unused) one after another.
+// Every texture's descriptor, and all images' texels (linear RGB; w unused) one after another,
+// read through texel_at (shaders/texels/: one binding, or windows over several).
 @group(0) @binding(20) var<storage, read> textures: array<Texture>;
 @group(0) @binding(21) var<storage, read> texels: array<vec4<f32>>;
 // One per triangle when the scene has textures (a placeholder otherwise).
@@ -48,7 +49,7 @@ fn triangle_uv(index: u32, b: vec3<f32>) -> vec2<f32> {
 
 // Texel (x, y) of an image, counted from its bottom-left corner.
 fn texel(t: Texture, x: u32, y: u32) -> vec3<f32> {
-    return texels[t.first_texel + y * t.width + x].xyz;
+    return texel_at(t.first_texel + y * t.width + x).xyz;
 }
 
 // The column or row below a sample position and the one after it, wrapped (repeat): positions
