@@ -8,7 +8,8 @@
 // a texture (HAS_TEXTURES, src/shader.rs).
 
 // Every texture's descriptor, and all images' texels (linear RGB; w a colour texture's alpha,
-// 1 where its file has none, and unused in the others) one after another.
+// 1 where its file has none, and unused in the others) one after another, read through
+// texel_at (shaders/texels/: one binding, or windows over several).
 @group(0) @binding(20) var<storage, read> textures: array<Texture>;
 @group(0) @binding(21) var<storage, read> texels: array<vec4<f32>>;
 // One per triangle when the scene has textures (a placeholder otherwise).
@@ -49,7 +50,7 @@ fn triangle_uv(index: u32, b: vec3<f32>) -> vec2<f32> {
 
 // Texel (x, y) of an image, counted from its bottom-left corner.
 fn texel(t: Texture, x: u32, y: u32) -> vec3<f32> {
-    return texels[t.first_texel + y * t.width + x].xyz;
+    return texel_at(t.first_texel + y * t.width + x).xyz;
 }
 
 // The column or row below a sample position and the one after it, wrapped (repeat): positions
@@ -132,8 +133,8 @@ fn image_alpha(t: Texture, uv: vec2<f32>) -> f32 {
     let fy = ys.weight;
     let row0 = t.first_texel + ys.pair.x * t.width;
     let row1 = t.first_texel + ys.pair.y * t.width;
-    let bottom = texels[row0 + xs.pair.x].w * (1.0 - fx) + texels[row0 + xs.pair.y].w * fx;
-    let top = texels[row1 + xs.pair.x].w * (1.0 - fx) + texels[row1 + xs.pair.y].w * fx;
+    let bottom = texel_at(row0 + xs.pair.x).w * (1.0 - fx) + texel_at(row0 + xs.pair.y).w * fx;
+    let top = texel_at(row1 + xs.pair.x).w * (1.0 - fx) + texel_at(row1 + xs.pair.y).w * fx;
     return bottom * (1.0 - fy) + top * fy;
 }
 

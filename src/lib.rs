@@ -31,5 +31,6 @@ pub mod scene;
 pub mod shader;
 pub mod shader_types;
 pub mod stdio;
+pub mod texel_windows;
 pub mod tonemap;
 pub mod viewer;

@@ -6,6 +6,7 @@ use crate::shader_types::{
     MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
     PRIMITIVE_TRIANGLE,
 };
+use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
@@ -441,9 +442,20 @@ pub fn render_kernel_source_for(variant: KernelVariant) -> String {
     render_kernel_source_with(variant, ParamsBinding::Uniform)
 }
 
-/// The whole kernel as one WGSL module, in the given variant, with `Params` bound as `params`.
+/// The whole kernel as one WGSL module, in the given variant, with `Params` bound as `params`
+/// and the texels in one binding.
 pub fn render_kernel_source_with(variant: KernelVariant, params: ParamsBinding) -> String {
+    render_kernel_source_with_texels(variant, params, TexelBinding::One)
+}
+
+/// [`render_kernel_source_with`], reading texels as `texels` says (src/texel_windows.rs).
+pub fn render_kernel_source_with_texels(
+    variant: KernelVariant,
+    params: ParamsBinding,
+    texels: TexelBinding,
+) -> String {
     let (scene_name, scene_text) = variant.binding.part();
+    let (texels_name, texels_text) = texels.part();
     let mut source = String::new();
     // An extension must be enabled before any declaration.
     if variant.binding.uses_ray_queries() {
@@ -458,6 +470,7 @@ pub fn render_kernel_source_with(variant: KernelVariant, params: ParamsBinding) 
             );
             source += &format!("// ---- features\n{}\n", variant.features.part());
             source += &format!("// ---- {scene_name}\n{scene_text}\n");
+            source += &format!("// ---- {texels_name}\n{texels_text}\n");
         }
     }
     source

@@ -242,6 +242,12 @@ fn asset(name: &str) -> Option<PathBuf> {
 /// The helmet seen from the front (the glTF's +z), `size`² pixels, with `lighting` (TOML
 /// lines) and `material` (a `[[meshes]]` line, or none for the file's own materials).
 fn render_helmet(helmet: &Path, size: u32, spp: u32, lighting: &str, material: &str) -> Image {
+    let scene = helmet_scene(helmet, size, spp, lighting, material);
+    common::render_cpu(&scene.kernel_scene(), spp)
+}
+
+/// The scene [`render_helmet`] renders.
+fn helmet_scene(helmet: &Path, size: u32, spp: u32, lighting: &str, material: &str) -> Scene {
     let dir = tempfile::tempdir().unwrap();
     let text = format!(
         r#"[camera]
@@ -268,8 +274,7 @@ file = "{}"
     );
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, text).unwrap();
-    let scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
-    common::render_cpu(&scene.kernel_scene(), spp)
+    Scene::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Khronos' DamagedHelmet.glb as its author made it (embedded JPEG maps, emissiveFactor
@@ -335,4 +340,38 @@ fn the_damaged_helmet_glows_only_where_its_emissive_map_says() {
         authored < 0.7 * white,
         "the helmet's centre averages {authored}, a white one's {white}"
     );
+}
+
+/// The helmet's five 2048² maps take 256 MiB as texels, twice lavapipe's 128 MiB storage
+/// binding: the GPU splits them over bindings (src/texel_windows.rs) and traces the CPU's
+/// paths, by the criterion of tests/gpu_vs_cpu.rs, at 64² under the environment map: four
+/// seeds at one path per pixel (four samples per pixel in all).
+#[test]
+fn the_damaged_helmet_renders_on_the_gpu_as_on_the_cpu() {
+    let (Some(helmet), Some(sky)) = (asset("DamagedHelmet.glb"), asset("royal_esplanade_1k.hdr"))
+    else {
+        return;
+    };
+    let Some(ctx) = common::gpu() else { return };
+    let lit = format!(
+        "max_bounces = 8\n[environment]\nfile = \"{}\"",
+        sky.display()
+    );
+    let mut scene = helmet_scene(&helmet, 64, 1, &lit, "").kernel_scene();
+    let mut gpu = glint::gpu::GpuRenderer::new(ctx, &scene).unwrap();
+    let limit = ctx.device.limits().max_storage_buffer_binding_size;
+    let bytes = scene.texels.len() as u64 * 16;
+    eprintln!(
+        "{bytes} bytes of texels, a binding holds {limit}: {:?}",
+        gpu.texel_binding()
+    );
+    assert_eq!(gpu.texel_binding().is_split(), bytes > limit);
+    let mut agreement = common::PathAgreement::default();
+    for seed in [1, 2, 3, 4] {
+        scene.params.seed = seed;
+        gpu.set_params(scene.params).unwrap();
+        let gpu_image = glint::render::render_image(&mut gpu, 1, 1).unwrap();
+        agreement.add(&common::render_cpu(&scene, 1), &gpu_image);
+    }
+    agreement.check(0.99);
 }

@@ -2,13 +2,15 @@
 //! byte for byte (naga's layouter), so the host and the kernel cannot drift apart.
 
 use glint::shader::{
-    render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
-    SceneCounts, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
+    render_kernel_source, render_kernel_source_for, render_kernel_source_with_texels,
+    KernelFeatures, KernelVariant, ParamsBinding, SceneBinding, SceneCounts, RENDER_ENTRY_POINT,
+    WORKGROUP_SIZE,
 };
 use glint::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
     Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs,
 };
+use glint::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
 
@@ -431,6 +433,91 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         ] {
             let source = render_kernel_source_for(KernelVariant { binding, features });
             assert!(!source.contains("rayQuery") && !source.contains("wgpu_ray_query"));
+        }
+    }
+}
+
+/// The storage bindings of `module`'s texel windows: (binding, element bytes) of every global
+/// bound at 21 or at one of [`EXTRA_WINDOW_BINDINGS`].
+fn texel_window_bindings(module: &naga::Module) -> Vec<(u32, u32)> {
+    let mut layouter = Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let mut out: Vec<_> = module
+        .global_variables
+        .iter()
+        .filter_map(|(_, v)| {
+            let binding = v.binding.as_ref()?.binding;
+            if binding != 21 && !EXTRA_WINDOW_BINDINGS.contains(&binding) {
+                return None;
+            }
+            assert_eq!(
+                v.space,
+                naga::AddressSpace::Storage {
+                    access: naga::StorageAccess::LOAD
+                },
+                "binding {binding}"
+            );
+            let naga::TypeInner::Array { base, .. } = module.types[v.ty].inner else {
+                panic!("binding {binding} is not an array");
+            };
+            Some((binding, layouter[base].size))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// Split texels (src/texel_windows.rs): the windowed kernel validates in every scene binding,
+/// with textures on and off, and reads windows 2 to 4 at the bindings the host binds them to,
+/// as read-only arrays of 16-byte texels like binding 21, with the host's window size; the
+/// one-binding kernel declares none of them, so scenes that fit keep their kernel.
+#[test]
+fn texel_windows_are_bound_where_the_host_binds_them() {
+    let counts = SceneCounts {
+        spheres: 2,
+        quads: 6,
+        materials: 5,
+        emitters: 1,
+    };
+    let split = TexelBinding::plan(1000, 4096).unwrap();
+    let TexelBinding::Windows { texels_per_window } = split else {
+        panic!("1000 texels fit 4096 bytes");
+    };
+    for binding in [
+        SceneBinding::Storage,
+        SceneBinding::Uniform(counts),
+        SceneBinding::Bvh {
+            uniform_nodes: 2048,
+            stack_size: 64,
+        },
+    ] {
+        for textures in [true, false] {
+            let variant = KernelVariant {
+                binding,
+                features: KernelFeatures {
+                    textures,
+                    ..KernelFeatures::ALL
+                },
+            };
+            let source = render_kernel_source_with_texels(variant, ParamsBinding::Uniform, split);
+            assert!(source.contains(&format!(
+                "const TEXELS_PER_WINDOW: u32 = {texels_per_window}u;"
+            )));
+            let module = validate_source(source);
+            let mut want = vec![(21, TEXEL_BYTES as u32)];
+            want.extend(EXTRA_WINDOW_BINDINGS.map(|b| (b, TEXEL_BYTES as u32)));
+            assert_eq!(texel_window_bindings(&module), want, "{binding:?}");
+            let one = render_kernel_source_with_texels(
+                variant,
+                ParamsBinding::Uniform,
+                TexelBinding::One,
+            );
+            assert_eq!(one, render_kernel_source_for(variant));
+            assert!(!one.contains("TEXELS_PER_WINDOW"));
+            assert_eq!(
+                texel_window_bindings(&validate_source(one)),
+                vec![(21, TEXEL_BYTES as u32)]
+            );
         }
     }
 }

@@ -17,10 +17,11 @@ use crate::output::Image;
 use crate::render::{check_size, variance_of_mean, Renderer};
 use crate::scene::KernelScene;
 use crate::shader::{
-    render_kernel_source_with, KernelFeatures, KernelVariant, ParamsBinding, SceneBinding,
+    render_kernel_source_with_texels, KernelFeatures, KernelVariant, ParamsBinding, SceneBinding,
     RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use crate::shader_types::{BvhNode, Params};
+use crate::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS};
 use anyhow::{anyhow, Result};
 use bytemuck::Pod;
 use wgpu::util::DeviceExt;
@@ -59,6 +60,8 @@ pub struct GpuRenderer<'a> {
     loop_iterations: u64,
     /// The hardware traversal's acceleration structure, bound with the kernel (kept alive).
     _acceleration: Option<AccelerationStructure>,
+    /// Where the kernel reads texels from (src/texel_windows.rs).
+    texel_binding: TexelBinding,
 }
 
 /// Wanted duration of one GPU submission: a batch longer than this is split into tiles.
@@ -83,6 +86,29 @@ pub fn storage_buffer<T: Pod + Default>(
     items: &[T],
 ) -> wgpu::Buffer {
     scene_buffer(ctx, label, items, wgpu::BufferUsages::STORAGE)
+}
+
+/// Checks that the kernel's storage bindings, `buffers`' and the extra texel windows among them,
+/// are within the device's `max_storage_buffers_per_shader_stage`: bad input naming both
+/// counts otherwise.
+fn check_storage_binding_count(
+    limits: &wgpu::Limits,
+    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
+) -> Result<(), crate::error::InputError> {
+    let storage = buffers
+        .iter()
+        .filter(|(_, ty, _)| matches!(ty, wgpu::BufferBindingType::Storage { .. }))
+        .count() as u32;
+    if storage > limits.max_storage_buffers_per_shader_stage {
+        return Err(crate::error::InputError(format!(
+            "the scene is too large for this GPU: its texture texels need {} more storage \
+             bindings, {storage} in all, but the device's max_storage_buffers_per_shader_stage \
+             is {}",
+            EXTRA_WINDOW_BINDINGS.len(),
+            limits.max_storage_buffers_per_shader_stage
+        )));
+    }
+    Ok(())
 }
 
 /// Bytes of the buffer [`scene_buffer`] makes for `items` (at least one element).
@@ -158,6 +184,28 @@ impl<'a> GpuRenderer<'a> {
         scene: &KernelScene,
         variant: KernelVariant,
     ) -> Result<GpuRenderer<'a>> {
+        Self::with_variant_and_texel_window(ctx, scene, variant, u64::MAX)
+    }
+
+    /// [`GpuRenderer::new`]'s kernel with texel bindings of at most `window_bytes` (or the
+    /// device's limit, if smaller): tests split small textures over several bindings with it
+    /// (src/texel_windows.rs).
+    pub fn with_texel_window(
+        ctx: &'a GpuContext,
+        scene: &KernelScene,
+        window_bytes: u64,
+    ) -> Result<GpuRenderer<'a>> {
+        let max_uniform = ctx.device.limits().max_uniform_buffer_binding_size;
+        let variant = KernelVariant::for_scene(scene, max_uniform);
+        Self::with_variant_and_texel_window(ctx, scene, variant, window_bytes)
+    }
+
+    fn with_variant_and_texel_window(
+        ctx: &'a GpuContext,
+        scene: &KernelScene,
+        variant: KernelVariant,
+        window_bytes: u64,
+    ) -> Result<GpuRenderer<'a>> {
         if !variant.features.covers(&KernelFeatures::of(scene)) {
             return Err(anyhow!(
                 "the kernel variant {variant:?} lacks features the scene uses"
@@ -184,9 +232,28 @@ impl<'a> GpuRenderer<'a> {
             ),
         };
         let read_only = wgpu::BufferBindingType::Storage { read_only: true };
+        // Texels beyond one binding are split over several (src/texel_windows.rs).
+        let limits = device.limits();
+        let window_bytes = window_bytes
+            .min(limits.max_storage_buffer_binding_size)
+            .min(limits.max_buffer_size);
+        let texel_binding = TexelBinding::plan(scene.texels.len() as u64, window_bytes)?;
+        let texel_windows = texel_binding.windows(scene.texels.len());
+        let window_labels = [
+            "texture texels",
+            "texture texels window 2",
+            "texture texels window 3",
+            "texture texels window 4",
+        ];
+        let texel_needs = texel_windows
+            .iter()
+            .zip(window_labels)
+            .map(|(range, label)| {
+                BufferNeed::new(label, array_bytes(&scene.texels[range.clone()]), read_only)
+            });
         // Before any upload: a scene the device cannot hold is bad input, not a wgpu error.
         check_buffers(
-            &device.limits(),
+            &limits,
             &[
                 BufferNeed::new("spheres", array_bytes(&scene.spheres), scene_type),
                 BufferNeed::new("quads", array_bytes(&scene.quads), scene_type),
@@ -210,7 +277,6 @@ impl<'a> GpuRenderer<'a> {
                     read_only,
                 ),
                 BufferNeed::new("textures", array_bytes(&scene.textures), read_only),
-                BufferNeed::new("texture texels", array_bytes(&scene.texels), read_only),
                 BufferNeed::new(
                     "triangle texture coordinates",
                     array_bytes(&scene.triangle_uvs),
@@ -236,7 +302,10 @@ impl<'a> GpuRenderer<'a> {
                 BufferNeed::new("readback", accum_size, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", aov_size, BufferBinding::Storage),
                 BufferNeed::new("aov_normal", aov_size, BufferBinding::Storage),
-            ],
+            ]
+            .into_iter()
+            .chain(texel_needs)
+            .collect::<Vec<_>>(),
         )?;
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("params"),
@@ -265,7 +334,21 @@ impl<'a> GpuRenderer<'a> {
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
         // Textures are storage buffers in every layout (shaders/texture.wgsl says why).
         let textures = storage_buffer(ctx, "textures", &scene.textures);
-        let texels = storage_buffer(ctx, "texture texels", &scene.texels);
+        let texels: Vec<_> = texel_windows
+            .iter()
+            .zip(window_labels)
+            .map(|(range, label)| storage_buffer(ctx, label, &scene.texels[range.clone()]))
+            .collect();
+        // Windows 2 to 4 are bound only where the kernel declares them.
+        let extra_windows: Vec<_> = if texel_binding.is_split() {
+            EXTRA_WINDOW_BINDINGS
+                .iter()
+                .zip(&texels[1..])
+                .map(|(&binding, buffer)| (binding, read_only, buffer))
+                .collect()
+        } else {
+            Vec::new()
+        };
         let triangle_uvs = storage_buffer(ctx, "triangle texture coordinates", &scene.triangle_uvs);
         let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
@@ -330,45 +413,50 @@ impl<'a> GpuRenderer<'a> {
             .iter()
             .map(|a| (27, read_only, &a.references))
             .collect();
+        let buffers: Vec<_> = [
+            (0, params_type, &params_buffer),
+            (1, scene_type, &spheres),
+            (2, scene_type, &quads),
+            (3, scene_type, &materials),
+            (4, read_write, &mean_buffer),
+            (5, read_write, &m2_buffer),
+            (6, scene_type, &emitters),
+            (7, read_write, &counter_buffer),
+            (8, read_only, &triangles),
+            (9, read_only, &triangle_normals),
+            (12, read_only, &bvh_nodes),
+            (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
+            (13, read_only, &bvh_primitives),
+            (10, read_write, &aov_buffers[0]),
+            (11, read_write, &aov_buffers[1]),
+            (16, read_write, &nonfinite_buffer),
+            (17, wgpu::BufferBindingType::Uniform, &tile_buffer),
+            (20, read_only, &textures),
+            (21, read_only, &texels[0]),
+            (22, read_only, &triangle_uvs),
+            (28, read_only, &triangle_tangents),
+            (18, read_only, &environment_texels),
+            (19, read_only, &environment_alias),
+            (24, read_only, &lights),
+            (25, read_only, &ggx_energy),
+        ]
+        .into_iter()
+        .chain(hardware_buffers)
+        .chain(extra_windows)
+        .collect();
+        if texel_binding.is_split() {
+            check_storage_binding_count(&limits, &buffers)?;
+        }
         let (bind_group_layout, bind_group) = compute_bind_group_with_tlas(
             device,
             "scene",
-            &[
-                (0, params_type, &params_buffer),
-                (1, scene_type, &spheres),
-                (2, scene_type, &quads),
-                (3, scene_type, &materials),
-                (4, read_write, &mean_buffer),
-                (5, read_write, &m2_buffer),
-                (6, scene_type, &emitters),
-                (7, read_write, &counter_buffer),
-                (8, read_only, &triangles),
-                (9, read_only, &triangle_normals),
-                (12, read_only, &bvh_nodes),
-                (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
-                (13, read_only, &bvh_primitives),
-                (10, read_write, &aov_buffers[0]),
-                (11, read_write, &aov_buffers[1]),
-                (16, read_write, &nonfinite_buffer),
-                (17, wgpu::BufferBindingType::Uniform, &tile_buffer),
-                (20, read_only, &textures),
-                (21, read_only, &texels),
-                (22, read_only, &triangle_uvs),
-                (28, read_only, &triangle_tangents),
-                (18, read_only, &environment_texels),
-                (19, read_only, &environment_alias),
-                (24, read_only, &lights),
-                (25, read_only, &ggx_energy),
-            ]
-            .into_iter()
-            .chain(hardware_buffers)
-            .collect::<Vec<_>>(),
+            &buffers,
             acceleration.as_ref().map(|a| (26, &a.tlas)),
         );
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("glint render kernel"),
             source: wgpu::ShaderSource::Wgsl(
-                render_kernel_source_with(variant, params_binding).into(),
+                render_kernel_source_with_texels(variant, params_binding, texel_binding).into(),
             ),
         });
         let pipeline = compute_pipeline(
@@ -406,6 +494,7 @@ impl<'a> GpuRenderer<'a> {
                 loop_iterations_per_sample(scene)
             },
             _acceleration: acceleration,
+            texel_binding,
         };
         renderer.warm_up()?;
         Ok(renderer)
@@ -526,6 +615,11 @@ impl<'a> GpuRenderer<'a> {
     /// The kernel variant this renderer runs.
     pub fn variant(&self) -> KernelVariant {
         self.variant
+    }
+
+    /// Where the kernel reads texels from: one binding, or windows over several.
+    pub fn texel_binding(&self) -> TexelBinding {
+        self.texel_binding
     }
 
     /// The kernel parameters in use (camera, size, counts).
