@@ -738,6 +738,7 @@ fn the_base_color_textures_alpha_is_kept_linear() {
             );
         }
     }
+}
 
 /// KHR_materials_unlit: the surface emits its base colour and reflects nothing; the file's
 /// other factors (metal, roughness, emission) do not apply; the extension is fully read (no
