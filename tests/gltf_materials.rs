@@ -83,6 +83,19 @@ fn loaded_material(material: serde_json::Value) -> glint::scene::Material {
     scene.materials[scene.triangles[0].material as usize].clone()
 }
 
+/// The file whose triangle has `material` is refused, the message naming the scene file's
+/// line, the mesh field, the glTF file and every needle.
+fn assert_material_refused(material: serde_json::Value, needles: &[&str]) {
+    let (json, bin) = triangle_gltf(material);
+    let message = load(&json, &bin).expect_err("the material should be refused");
+    for needle in ["scene.toml:", "meshes[0].file", "t.gltf: "]
+        .iter()
+        .chain(needles)
+    {
+        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    }
+}
+
 /// The warning lines `glint render --cpu` prints for the file.
 fn render_warnings(json: &serde_json::Value, bin: &[u8]) -> Vec<String> {
     let dir = write(json, bin);
@@ -273,14 +286,7 @@ fn factors_out_of_range_are_errors() {
             &["material0", "attenuationColor must be in [0, 1]"][..],
         ),
     ] {
-        let (json, bin) = triangle_gltf(material);
-        let message = load(&json, &bin).expect_err("the material should be refused");
-        for needle in ["scene.toml:", "meshes[0].file", "t.gltf: "]
-            .iter()
-            .chain(needles)
-        {
-            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
-        }
+        assert_material_refused(material, needles);
     }
 }
 
@@ -667,14 +673,7 @@ fn alpha_out_of_range_is_an_error_naming_the_field() {
             &["materials[0].alphaMode", "not a glTF alpha mode"][..],
         ),
     ] {
-        let (json, bin) = triangle_gltf(material);
-        let message = load(&json, &bin).expect_err("the material should be refused");
-        for needle in ["scene.toml:", "meshes[0].file", "t.gltf: "]
-            .iter()
-            .chain(needles)
-        {
-            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
-        }
+        assert_material_refused(material, needles);
     }
     let (json, bin) = triangle_gltf(serde_json::json!({"alphaMode": "MASK", "alphaCutoff": 2}));
     let dir = write(&json, &bin);
