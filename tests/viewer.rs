@@ -325,6 +325,35 @@ fn wait_for(rx: &mpsc::Receiver<Value>, what: &str, pred: impl Fn(&Value) -> boo
     }
 }
 
+/// Drives a viewer whose script holds two `wait-edit`s through `good` then `broken` (each
+/// an edit on disk, made when the viewer waits for it); checks that it exits well, reloads
+/// the good edit and refuses the broken one. The refusal's message and each frame's spp.
+fn good_then_broken_edit(
+    (child, rx): (Child, mpsc::Receiver<Value>),
+    good: impl FnOnce(),
+    broken: impl FnOnce(),
+) -> (String, Vec<u64>) {
+    let waiting = |v: &Value| v["event"] == "waiting-for-edit";
+    let mut log = wait_for(&rx, "first wait", waiting);
+    good();
+    log.extend(wait_for(&rx, "second wait", waiting));
+    broken();
+    log.extend(rx.iter());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{}: {stderr}", out.status);
+    let reloads = events(&log, "reload");
+    assert_eq!(reloads.len(), 2, "{log:?}");
+    assert_eq!(reloads[0]["ok"].as_bool(), Some(true), "{log:?}");
+    assert_eq!(reloads[1]["ok"].as_bool(), Some(false), "{log:?}");
+    let error = reloads[1]["error"].as_str().unwrap().to_owned();
+    let spp = frames(&log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect();
+    (error, spp)
+}
+
 #[test]
 fn scene_edits_on_disk_are_picked_up_and_broken_ones_keep_the_last_good_scene() {
     if skip_gpu() {
@@ -852,32 +881,18 @@ fn a_model_file_is_viewed_and_its_edits_are_picked_up() {
             "3:wait-edit; 6:wait-edit",
         ],
     ));
-    let waiting = |v: &Value| v["event"] == "waiting-for-edit";
-    let mut log = wait_for(&rx, "first wait", waiting);
     // A dimmer point light, then a negative intensity.
     let bright = "\"intensity\": 6830";
     assert!(original.contains(bright));
-    let dim = original.replace(bright, "\"intensity\": 683");
-    save_atomically(&model, &dim);
-    log.extend(wait_for(&rx, "second wait", waiting));
-    save_atomically(&model, &original.replace(bright, "\"intensity\": -1"));
-    log.extend(rx.iter());
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{}: {stderr}", out.status);
-    let reloads = events(&log, "reload");
-    assert_eq!(reloads.len(), 2, "{log:?}");
-    assert_eq!(reloads[0]["ok"].as_bool(), Some(true), "{log:?}");
-    assert_eq!(reloads[1]["ok"].as_bool(), Some(false), "{log:?}");
-    let error = reloads[1]["error"].as_str().unwrap();
+    let (error, spp) = good_then_broken_edit(
+        (child, rx),
+        || save_atomically(&model, &original.replace(bright, "\"intensity\": 683")),
+        || save_atomically(&model, &original.replace(bright, "\"intensity\": -1")),
+    );
     assert!(
         error.contains("lc.gltf") && error.contains("lights[0].intensity"),
         "{error}"
     );
-    let spp: Vec<u64> = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
     assert_eq!(spp, [1, 3, 5, 1, 3, 5, 7, 9, 11, 13]);
 }
 
@@ -920,24 +935,11 @@ fn edits_of_a_scenes_texture_are_picked_up() {
             "3:wait-edit; 6:wait-edit",
         ],
     ));
-    let waiting = |v: &Value| v["event"] == "waiting-for-edit";
-    let mut log = wait_for(&rx, "first wait", waiting);
-    save_png(200);
-    log.extend(wait_for(&rx, "second wait", waiting));
-    save_atomically(&texture, "not a PNG");
-    log.extend(rx.iter());
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{}: {stderr}", out.status);
-    let reloads = events(&log, "reload");
-    assert_eq!(reloads.len(), 2, "{log:?}");
-    assert_eq!(reloads[0]["ok"].as_bool(), Some(true), "{log:?}");
-    assert_eq!(reloads[1]["ok"].as_bool(), Some(false), "{log:?}");
-    let error = reloads[1]["error"].as_str().unwrap();
+    let (error, spp) = good_then_broken_edit(
+        (child, rx),
+        || save_png(200),
+        || save_atomically(&texture, "not a PNG"),
+    );
     assert!(error.contains("t.png"), "{error}");
-    let spp: Vec<u64> = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
     assert_eq!(spp, [1, 3, 5, 1, 3, 5, 7, 9, 11, 13]);
 }
