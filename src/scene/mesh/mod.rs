@@ -10,6 +10,7 @@
 mod gltf;
 mod gltf_cameras;
 mod gltf_lights;
+mod gltf_material;
 mod gltf_nodes;
 mod obj;
 mod ply;
