@@ -16,6 +16,7 @@ pub mod cli;
 pub mod compare;
 pub mod cpu;
 pub mod denoise;
+pub mod dielectric_energy;
 pub mod error;
 pub mod exr_header;
 pub mod ggx_energy;

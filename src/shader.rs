@@ -10,7 +10,7 @@ use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 29] = [
+pub const SHADER_PARTS: [(&str, &str); 30] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -37,6 +37,10 @@ pub const SHADER_PARTS: [(&str, &str); 29] = [
     (
         "ggx_energy.wgsl",
         include_str!("../shaders/ggx_energy.wgsl"),
+    ),
+    (
+        "dielectric_energy.wgsl",
+        include_str!("../shaders/dielectric_energy.wgsl"),
     ),
     (
         "rough_dielectric.wgsl",

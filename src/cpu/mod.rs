@@ -10,6 +10,7 @@ pub mod bvh;
 pub mod camera;
 pub mod conductor;
 pub mod dielectric;
+pub mod dielectric_energy;
 pub mod diffuse;
 pub mod environment;
 pub mod frame;

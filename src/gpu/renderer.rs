@@ -362,6 +362,14 @@ impl<'a> GpuRenderer<'a> {
             &[]
         };
         let ggx_energy = storage_buffer(ctx, "GGX energy tables", ggx_energy);
+        // The rough dielectric's compensation tables (src/dielectric_energy.rs), a placeholder
+        // where no material transmits.
+        let dielectric_energy: &[f32] = if variant.features.pbr && variant.features.transmission {
+            crate::dielectric_energy::dielectric_energy_table()
+        } else {
+            &[]
+        };
+        let dielectric_energy = storage_buffer(ctx, "dielectric energy tables", dielectric_energy);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -439,6 +447,7 @@ impl<'a> GpuRenderer<'a> {
             (19, read_only, &environment_alias),
             (24, read_only, &lights),
             (25, read_only, &ggx_energy),
+            (33, read_only, &dielectric_energy),
         ]
         .into_iter()
         .chain(hardware_buffers)

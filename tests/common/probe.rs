@@ -133,6 +133,11 @@ fn run_probe_with(
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let lights = storage_buffer(ctx, "lights", &scene.lights);
     let ggx_energy = storage_buffer(ctx, "GGX energy", glint::ggx_energy::ggx_energy_table());
+    let dielectric_energy = storage_buffer(
+        ctx,
+        "dielectric energy",
+        glint::dielectric_energy::dielectric_energy_table(),
+    );
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -177,6 +182,7 @@ fn run_probe_with(
             (19, read_only, &environment_alias),
             (24, read_only, &lights),
             (25, read_only, &ggx_energy),
+            (33, read_only, &dielectric_energy),
         ]
         .into_iter()
         .chain(hardware)
