@@ -1144,6 +1144,36 @@ fn reference_rough_dielectric_pdf(
     }
 }
 
+/// The compensated rough dielectric's density: the single-scattering reference above with the
+/// probability the sampler gives it, else a cosine lobe below (probability t) or above, with
+/// the shares the code's tables give (src/cpu/rough_dielectric.rs says how they are chosen).
+fn reference_compensated_pdf(
+    wo: glam::DVec3,
+    wi: glam::DVec3,
+    n: glam::DVec3,
+    alpha: f64,
+    eta_o: f64,
+    eta_i: f64,
+) -> f64 {
+    let (cos_o, cos_i) = (wo.dot(n), wi.dot(n));
+    if cos_o <= 0.0 || cos_i == 0.0 {
+        return 0.0;
+    }
+    let (single, transmitted) = glint::cpu::rough_dielectric::rough_dielectric_lobe_shares(
+        alpha as f32,
+        (eta_i / eta_o) as f32,
+        cos_o as f32,
+    );
+    let (single, transmitted) = (single as f64, transmitted as f64);
+    let share = if cos_i > 0.0 {
+        1.0 - transmitted
+    } else {
+        transmitted
+    };
+    single * reference_rough_dielectric_pdf(wo, wi, n, alpha, eta_o, eta_i)
+        + (1.0 - single) * share * cos_i.abs() / PI
+}
+
 /// (name, entering, θo in degrees): light entering glass at 60°, leaving it at 30° (inside
 /// the critical angle, 41.8°) and at 60° (beyond it: only microfacets tilted towards wo
 /// refract).
@@ -1192,7 +1222,7 @@ fn cpu_rough_dielectric_sampling() {
                 .collect();
             let (kept, absorbed) = split_absorbed(&samples);
             let pdf = |d: Vec3| {
-                reference_rough_dielectric_pdf(
+                reference_compensated_pdf(
                     wo.as_dvec3(),
                     d.as_dvec3().normalize(),
                     n.as_dvec3(),
@@ -1282,7 +1312,7 @@ fn check_pbr_transmission_samples(
         let d = d.as_dvec3().normalize();
         let (wo, n) = (wo.as_dvec3(), n.as_dvec3());
         let cos = d.dot(n);
-        let mut p = p_t * reference_rough_dielectric_pdf(wo, d, n, alpha, eta_o, eta_i);
+        let mut p = p_t * reference_compensated_pdf(wo, d, n, alpha, eta_o, eta_i);
         if cos > 0.0 {
             p += p_s * reference_ggx_pdf(wo, d, n, alpha) + (1.0 - p_s - p_t) * cos / PI;
         }
