@@ -15,7 +15,8 @@
 //!
 //! Computed here at first use by integrating with the lobe's own sampler (visible normals,
 //! both the reflected and the refracted branch weighted by Fresnel) on a stratified grid:
-//! deterministic (the parallel rows are gathered in order), about 0.2 s on two cores. The
+//! deterministic (the parallel rows are gathered in order), about 0.8 s of CPU time split over
+//! the cores (its test prints the time). The
 //! same numbers feed the GPU (binding 33) and the CPU reference.
 
 use crate::cpu::dielectric::fresnel_dielectric;
@@ -32,7 +33,7 @@ pub const DIELECTRIC_ENERGY_ETA: usize = 24;
 /// The smallest α the table is integrated at (the PBR material's own minimum).
 pub const DIELECTRIC_ENERGY_MIN_ALPHA: f32 = 1e-3;
 /// Strata per axis of the integration grid at each table point.
-const STRATA: usize = 24;
+const STRATA: usize = 20;
 
 /// Sizes of the parts: E over (side, r, α, μ), E_avg over (side, r, α), 1 − F_avg over r.
 const ALBEDO_LEN: usize =
@@ -200,8 +201,35 @@ mod tests {
         sum * (2.0 / nc as f64) * (2.0 * PI / np as f64)
     }
 
+    /// The WGSL lookups spell the layout out as constants: they must be these.
+    #[test]
+    fn the_wgsl_lookups_use_this_layout() {
+        let wgsl = include_str!("../shaders/dielectric_energy.wgsl");
+        for line in [
+            format!("DIELECTRIC_ENERGY_MU: u32 = {DIELECTRIC_ENERGY_MU}u;"),
+            format!("DIELECTRIC_ENERGY_ALPHA: u32 = {DIELECTRIC_ENERGY_ALPHA}u;"),
+            format!("DIELECTRIC_ENERGY_ETA: u32 = {DIELECTRIC_ENERGY_ETA}u;"),
+            format!("DIELECTRIC_ENERGY_OFFSET_AVERAGE: u32 = {OFFSET_AVERAGE}u;"),
+            format!("DIELECTRIC_ENERGY_OFFSET_TRANSMITTANCE: u32 = {OFFSET_TRANSMITTANCE}u;"),
+            format!(
+                "DIELECTRIC_ENERGY_MAX_R: f32 = {0:.1} / {1:.1};",
+                MAX_IOR - 1.0,
+                MAX_IOR + 1.0
+            ),
+        ] {
+            assert!(
+                wgsl.contains(&line),
+                "shaders/dielectric_energy.wgsl lacks {line:?}"
+            );
+        }
+    }
+
     #[test]
     fn the_table_matches_an_independent_quadrature() {
+        let start = std::time::Instant::now();
+        let t = dielectric_energy_table();
+        // Printed, not asserted: timings depend on the machine.
+        eprintln!("dielectric energy table: {:?}", start.elapsed());
         for (mu, alpha, etap) in [
             (0.5f32, 0.5f32, 1.5f32),
             (0.9, 1.0, 1.5),
@@ -217,7 +245,6 @@ mod tests {
             );
         }
         // Nothing is created, and the smooth interface keeps everything.
-        let t = dielectric_energy_table();
         assert!(t[..OFFSET_TRANSMITTANCE]
             .iter()
             .all(|v| (0.0..=1.0 + 1e-4).contains(v)));
@@ -226,6 +253,11 @@ mod tests {
         let k = (1..DIELECTRIC_ENERGY_ETA)
             .find(|&k| grid_eta(k) > 1.4)
             .unwrap();
-        assert!(t[OFFSET_TRANSMITTANCE] == 1.0 && t[OFFSET_TRANSMITTANCE + k] < 0.95);
+        let (index_matched, glass) = (t[OFFSET_TRANSMITTANCE], t[OFFSET_TRANSMITTANCE + k]);
+        assert!(
+            (index_matched - 1.0).abs() < 1e-6 && (0.85..0.95).contains(&glass),
+            "1 − F_avg: {index_matched} at η 1, {glass} at η {}",
+            grid_eta(k)
+        );
     }
 }

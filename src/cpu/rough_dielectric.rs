@@ -115,23 +115,34 @@ fn single_scattering_sample(
     choice: f32,
 ) -> RoughDielectricSample {
     let m = sample_ggx_visible_normal(wo, alpha, u);
-    let cos_o = wo.dot(m);
     let eta = 1.0 / etap;
-    let f = fresnel_dielectric(cos_o, eta);
-    let g1 = 1.0 / (1.0 + ggx_lambda(wo, alpha));
-    if choice < f {
-        let wi = (2.0 * cos_o * m - wo).normalize();
-        let g2 = 1.0 / (1.0 + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha));
-        return RoughDielectricSample {
-            wi,
-            weight: if wi.z > 0.0 { g2 / g1 } else { 0.0 },
-            refracted: false,
-        };
+    if choice < fresnel_dielectric(wo.dot(m), eta) {
+        reflection_about(alpha, wo, m)
+    } else {
+        refraction_about(alpha, eta, wo, m)
     }
-    // Snell's law about m (F < 1, so no total internal reflection).
+}
+
+/// The reflection of wo about the microfacet normal m, weighted G2/G1.
+fn reflection_about(alpha: f32, wo: Vec3, m: Vec3) -> RoughDielectricSample {
+    let wi = (2.0 * wo.dot(m) * m - wo).normalize();
+    let g1 = 1.0 / (1.0 + ggx_lambda(wo, alpha));
+    let g2 = 1.0 / (1.0 + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha));
+    RoughDielectricSample {
+        wi,
+        weight: if wi.z > 0.0 { g2 / g1 } else { 0.0 },
+        refracted: false,
+    }
+}
+
+/// The refraction of wo through the microfacet normal m (η = η_wo / η_wi, F < 1 so no total
+/// internal reflection), weighted G2/G1 times the radiance scaling η².
+fn refraction_about(alpha: f32, eta: f32, wo: Vec3, m: Vec3) -> RoughDielectricSample {
+    let cos_o = wo.dot(m);
     let sin2_t = eta * eta * (1.0 - cos_o * cos_o).max(0.0);
     let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
     let wi = (-eta * wo + (eta * cos_o - cos_t) * m).normalize();
+    let g1 = 1.0 / (1.0 + ggx_lambda(wo, alpha));
     let g2 = 1.0 / (1.0 + ggx_lambda(wo, alpha) + ggx_lambda(wi, alpha));
     RoughDielectricSample {
         wi,
@@ -148,18 +159,14 @@ fn single_scattering_sample(
 /// F times the reflection's weight plus (1 − F) times the refraction's, η² taken out. Its mean
 /// over u is E(cos θo); `crate::dielectric_energy` integrates it.
 pub fn single_scattering_albedo_sample(alpha: f32, etap: f32, wo: Vec3, u: (f32, f32)) -> f32 {
-    let f = fresnel_dielectric(wo.dot(sample_ggx_visible_normal(wo, alpha, u)), 1.0 / etap);
-    // The sampler's two branches at the same u: `choice` 0 (below F), then 1 (above it).
-    let reflected = if f > 0.0 {
-        single_scattering_sample(alpha, etap, wo, u, 0.0).weight
-    } else {
-        0.0
-    };
+    let m = sample_ggx_visible_normal(wo, alpha, u);
+    let eta = 1.0 / etap;
+    let f = fresnel_dielectric(wo.dot(m), eta);
+    let reflected = f * reflection_about(alpha, wo, m).weight;
     if f >= 1.0 {
         return reflected;
     }
-    let refracted = single_scattering_sample(alpha, etap, wo, u, 1.0).weight * etap * etap;
-    f * reflected + (1.0 - f) * refracted
+    reflected + (1.0 - f) * refraction_about(alpha, eta, wo, m).weight * etap * etap
 }
 
 /// Kulla and Conty's compensation at one shading point.
