@@ -4,12 +4,15 @@
 // dielectric layer by reciprocal albedo scaling; with transmission T, (1 - T) of that stack and T
 // of rough_dielectric.wgsl's rough glass, its refraction tinted by the base colour. Refracted
 // samples are marked delta: shadow rays do not pass through surfaces, so what they reach counts
-// in full.
+// in full. Over that stack the sheen (sheen.wgsl) and over it the coat (clearcoat.wgsl), each
+// scaling what lies below: f = coat + below_coat (sheen + below_sheen base).
 
 // The smallest GGX alpha of the material (roughness 0.032).
 const PBR_MIN_ALPHA: f32 = 1e-3;
 // Bounds of the probability of sampling the specular lobe, so neither strategy starves.
 const MIN_LOBE_PROBABILITY: f32 = 0.1;
+// The most the coat's and the sheen's lobes are each sampled with.
+const MAX_LAYER_PROBABILITY: f32 = 0.45;
 
 struct PbrLobes {
     base: vec3<f32>,
@@ -28,6 +31,13 @@ struct PbrLobes {
     etap: f32,
     specular_probability: f32,
     transmission_probability: f32,
+    // The coat and the sheen (none where the material has none or they are compiled out),
+    // their sampling probabilities, and the share of light from wo that passes both.
+    coat: ClearcoatLobe,
+    sheen: SheenLobe,
+    coat_probability: f32,
+    sheen_probability: f32,
+    layers_o: f32,
 }
 
 fn channel_average(v: vec3<f32>) -> f32 {
@@ -83,6 +93,37 @@ fn pbr_lobes(m: Material, mu_o: f32, front_face: bool) -> PbrLobes {
         specular_share = clamp(specular_weight / opaque_total, MIN_LOBE_PROBABILITY, 1.0 - MIN_LOBE_PROBABILITY);
     }
     l.specular_probability = (1.0 - l.transmission_probability) * specular_share;
+    // The layers on top: their lobes take shares of the samples by their albedos at mu_o
+    // against the stack's (which they dim), each within [0.1, 0.45] when present.
+    l.coat = no_clearcoat();
+    if HAS_CLEARCOAT && m.clearcoat > 0.0 {
+        l.coat = clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, mu_o);
+    }
+    l.sheen = no_sheen();
+    if HAS_SHEEN && max(m.sheen_color.x, max(m.sheen_color.y, m.sheen_color.z)) > 0.0 {
+        l.sheen = sheen_lobe(m.sheen_color, m.sheen_roughness, mu_o);
+    }
+    let below_coat = clearcoat_transmitted_o(l.coat);
+    l.layers_o = below_coat * sheen_transmitted_o(l.sheen);
+    l.coat_probability = 0.0;
+    l.sheen_probability = 0.0;
+    let has_sheen = max(l.sheen.color.x, max(l.sheen.color.y, l.sheen.color.z)) > 0.0;
+    if (HAS_CLEARCOAT || HAS_SHEEN) && (l.coat.weight > 0.0 || has_sheen) {
+        let coat_weight = l.coat.specular_albedo_o;
+        let sheen_weight = below_coat * l.sheen.albedo_o;
+        let all = coat_weight + sheen_weight + l.coat.ms_albedo_o + l.layers_o * total;
+        if all > 0.0 {
+            if l.coat.weight > 0.0 {
+                l.coat_probability = clamp(coat_weight / all, MIN_LOBE_PROBABILITY, MAX_LAYER_PROBABILITY);
+            }
+            if has_sheen {
+                l.sheen_probability = clamp(sheen_weight / all, MIN_LOBE_PROBABILITY, MAX_LAYER_PROBABILITY);
+            }
+        }
+        let rest = 1.0 - l.coat_probability - l.sheen_probability;
+        l.specular_probability *= rest;
+        l.transmission_probability *= rest;
+    }
     return l;
 }
 
@@ -97,7 +138,7 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
         if !HAS_TRANSMISSION || transmissive <= 0.0 {
             return vec3<f32>(0.0);
         }
-        return l.base * (transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+        return l.base * (transmissive * l.layers_o * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }
     let opaque = (1.0 - l.metallic) * (1.0 - l.transmission);
     let h = normalize(wo + wi);
@@ -110,7 +151,9 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
     let ab_i = ggx_albedo(wi.z, l.alpha);
     let e_i = ab_i.x + ab_i.y;
-    var out = specular;
+    // The specular lobes apart from the broad ones: the coat scales them as narrow lobes.
+    var narrow = specular;
+    var out = vec3<f32>(0.0);
     if l.e_average < 1.0 {
         let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
         out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
@@ -121,9 +164,18 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let base_weight = select(vec3<f32>(0.0), transmitted / room, room > vec3<f32>(0.0));
     out += opaque * l.base * base_weight * (wi.z / PI);
     if HAS_TRANSMISSION && transmissive > 0.0 {
-        out += vec3<f32>(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+        narrow += vec3<f32>(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }
-    return out;
+    if HAS_SHEEN && max(l.sheen.color.x, max(l.sheen.color.y, l.sheen.color.z)) > 0.0 {
+        let sheen = sheen_eval(l.sheen, wo, wi);
+        out = sheen.f_cos + sheen.below * out;
+        narrow *= sheen.below;
+    }
+    if HAS_CLEARCOAT && l.coat.weight > 0.0 {
+        let coat = clearcoat_eval(l.coat, wo, wi);
+        return vec3<f32>(coat.f_cos) + coat.below_broad * out + coat.below_narrow * narrow;
+    }
+    return out + narrow;
 }
 
 // The mixture pdf of pbr_sample; wo and wi in the local frame.
@@ -138,8 +190,16 @@ fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
         pdf = p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo, wi);
     }
     if wi.z > 0.0 {
+        let p_coat = l.coat_probability;
+        let p_sheen = l.sheen_probability;
         pdf += p_specular * ggx_reflection_pdf(wo, wi, l.alpha)
-            + (1.0 - p_specular - p_transmission) * (wi.z / PI);
+            + (1.0 - p_specular - p_transmission - p_coat - p_sheen) * (wi.z / PI);
+        if HAS_CLEARCOAT && p_coat > 0.0 {
+            pdf += p_coat * ggx_reflection_pdf(wo, wi, l.coat.alpha);
+        }
+        if HAS_SHEEN {
+            pdf += p_sheen * UNIFORM_HEMISPHERE_PDF;
+        }
     }
     return pdf;
 }
@@ -158,7 +218,7 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32
         if s.refracted {
             // Only the transmission lobe reaches below: the mixture's f cos / pdf is the lobe's
             // own weight times its share over its probability (finite at ior 1 too).
-            let share = (1.0 - l.metallic) * l.transmission / p_transmission;
+            let share = (1.0 - l.metallic) * l.transmission * l.layers_o / p_transmission;
             out.weight = l.base * (s.weight * share);
             out.pdf = p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo_l, s.wi);
             out.is_delta = true;
@@ -167,6 +227,14 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32
     } else if choice < p_transmission + l.specular_probability {
         let h = sample_ggx_visible_normal(wo_l, l.alpha, u);
         wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
+        out.dir = normalize(from_local(wi_l, n));
+    } else if HAS_CLEARCOAT && choice < p_transmission + l.specular_probability + l.coat_probability {
+        let h = sample_ggx_visible_normal(wo_l, l.coat.alpha, u);
+        wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
+        out.dir = normalize(from_local(wi_l, n));
+    } else if HAS_SHEEN
+        && choice < p_transmission + l.specular_probability + l.coat_probability + l.sheen_probability {
+        wi_l = sample_uniform_hemisphere(u);
         out.dir = normalize(from_local(wi_l, n));
     } else {
         out.dir = sample_cosine_hemisphere(n, u);

@@ -181,6 +181,23 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
             // glTF's transmissionTexture: its R channel multiplies the factor.
             out.transmission = m.transmission * texture_lookup(m.transmission_texture, uv).x;
         }
+        // KHR_materials_clearcoat's textures: R multiplies the factor, G the roughness (the
+        // loader puts it in x).
+        if m.clearcoat_texture != NO_TEXTURE {
+            out.clearcoat = m.clearcoat * texture_lookup(m.clearcoat_texture, uv).x;
+        }
+        if m.clearcoat_roughness_texture != NO_TEXTURE {
+            let r = texture_lookup(m.clearcoat_roughness_texture, uv).x;
+            out.clearcoat_alpha = m.clearcoat_alpha * (r * r);
+        }
+        // KHR_materials_sheen's: RGB multiplies the colour, the roughness (moved to x) the
+        // roughness.
+        if m.sheen_color_texture != NO_TEXTURE {
+            out.sheen_color = m.sheen_color * texture_lookup(m.sheen_color_texture, uv);
+        }
+        if m.sheen_roughness_texture != NO_TEXTURE {
+            out.sheen_roughness = m.sheen_roughness * texture_lookup(m.sheen_roughness_texture, uv).x;
+        }
         out.emission = emission_at(m, uv);
     }
     return out;

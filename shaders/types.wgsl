@@ -125,6 +125,22 @@ struct Material {
     // mesh (KHR_materials_volume, Beer-Lambert); distance 0 where there is none.
     attenuation_color: vec3<f32>,
     attenuation_distance: f32,
+    // PBR: KHR_materials_clearcoat's layer (clearcoat.wgsl): its weight, its GGX alpha, and
+    // textures whose x multiplies the weight and whose y the roughness (alpha by y * y).
+    clearcoat: f32,
+    clearcoat_alpha: f32,
+    clearcoat_texture: u32,
+    clearcoat_roughness_texture: u32,
+    // The coat's own tangent-space normal map and its scale, or NO_TEXTURE.
+    clearcoat_normal_texture: u32,
+    clearcoat_normal_scale: f32,
+    // PBR: KHR_materials_sheen (sheen.wgsl): the roughness (not squared) and textures
+    // multiplying the colour (rgb) and the roughness (its alpha), or NO_TEXTURE.
+    sheen_roughness: f32,
+    sheen_color_texture: u32,
+    // Black where there is no sheen.
+    sheen_color: vec3<f32>,
+    sheen_roughness_texture: u32,
 }
 
 const NO_TEXTURE: u32 = 0xffffffffu;

@@ -31,6 +31,7 @@ pub mod render;
 pub mod scene;
 pub mod shader;
 pub mod shader_types;
+pub mod sheen_energy;
 pub mod stdio;
 pub mod texel_windows;
 pub mod tonemap;

@@ -10,7 +10,7 @@ use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 30] = [
+pub const SHADER_PARTS: [(&str, &str); 33] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -46,6 +46,12 @@ pub const SHADER_PARTS: [(&str, &str); 30] = [
         "rough_dielectric.wgsl",
         include_str!("../shaders/rough_dielectric.wgsl"),
     ),
+    (
+        "sheen_energy.wgsl",
+        include_str!("../shaders/sheen_energy.wgsl"),
+    ),
+    ("clearcoat.wgsl", include_str!("../shaders/clearcoat.wgsl")),
+    ("sheen.wgsl", include_str!("../shaders/sheen.wgsl")),
     ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
@@ -270,6 +276,12 @@ pub struct KernelFeatures {
     /// pbr's transmission lobe (shaders/rough_dielectric.wgsl), for pbr materials with
     /// transmission.
     pub transmission: bool,
+    /// pbr's KHR_materials_clearcoat layer (shaders/clearcoat.wgsl), for pbr materials with a
+    /// coat.
+    pub clearcoat: bool,
+    /// pbr's KHR_materials_sheen layer (shaders/sheen.wgsl) and its albedo table, for pbr
+    /// materials with a sheen.
+    pub sheen: bool,
     /// Beer–Lambert attenuation inside meshes (shaders/volume.wgsl), for materials with an
     /// attenuation distance.
     pub volume: bool,
@@ -300,6 +312,8 @@ impl KernelFeatures {
         dielectric: true,
         pbr: true,
         transmission: true,
+        clearcoat: true,
+        sheen: true,
         volume: true,
         aovs: true,
         textures: true,
@@ -326,6 +340,14 @@ impl KernelFeatures {
                 m.kind == MATERIAL_PBR
                     && (m.transmission > 0.0 || m.transmission_texture != NO_TEXTURE)
             }),
+            clearcoat: scene
+                .materials
+                .iter()
+                .any(|m| m.kind == MATERIAL_PBR && m.clearcoat > 0.0),
+            sheen: scene
+                .materials
+                .iter()
+                .any(|m| m.kind == MATERIAL_PBR && m.sheen_color.iter().any(|&c| c > 0.0)),
             volume: scene.materials.iter().any(|m| m.attenuation_distance > 0.0),
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
@@ -350,6 +372,8 @@ impl KernelFeatures {
             && needs(self.dielectric, other.dielectric)
             && needs(self.pbr, other.pbr)
             && needs(self.transmission, other.transmission)
+            && needs(self.clearcoat, other.clearcoat)
+            && needs(self.sheen, other.sheen)
             && needs(self.volume, other.volume)
             && needs(self.aovs, other.aovs)
             && needs(self.textures, other.textures)
@@ -365,7 +389,8 @@ impl KernelFeatures {
             "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
              const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
              const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
-             const HAS_TRANSMISSION: bool = {};\nconst HAS_VOLUME: bool = {};\n\
+             const HAS_TRANSMISSION: bool = {};\nconst HAS_CLEARCOAT: bool = {};\n\
+             const HAS_SHEEN: bool = {};\nconst HAS_VOLUME: bool = {};\n\
              const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
@@ -378,6 +403,8 @@ impl KernelFeatures {
             self.dielectric,
             self.pbr,
             self.pbr && self.transmission,
+            self.pbr && self.clearcoat,
+            self.pbr && self.sheen,
             self.volume,
             self.aovs,
             self.textures,

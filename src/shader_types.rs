@@ -138,6 +138,23 @@ pub struct Material {
     pub attenuation_color: [f32; 3],
     /// 0 where there is no attenuation (glTF's default, +∞).
     pub attenuation_distance: f32,
+    /// PBR: KHR_materials_clearcoat's layer (`src/cpu/clearcoat.rs`): its weight, its GGX α
+    /// (clearcoat roughness squared), and textures whose x (glTF's R) multiplies the weight
+    /// and whose y (G) multiplies the roughness (α by y²), or [`NO_TEXTURE`].
+    pub clearcoat: f32,
+    pub clearcoat_alpha: f32,
+    pub clearcoat_texture: u32,
+    pub clearcoat_roughness_texture: u32,
+    /// The coat's own tangent-space normal map and its scale, or [`NO_TEXTURE`].
+    pub clearcoat_normal_texture: u32,
+    pub clearcoat_normal_scale: f32,
+    /// PBR: KHR_materials_sheen (`src/cpu/sheen.rs`): the sheen roughness (not squared), and
+    /// textures multiplying the colour (RGB) and the roughness (its alpha), or [`NO_TEXTURE`].
+    pub sheen_roughness: f32,
+    pub sheen_color_texture: u32,
+    /// Black where there is no sheen.
+    pub sheen_color: [f32; 3],
+    pub sheen_roughness_texture: u32,
 }
 
 /// `Material::alpha_mode`: glTF's OPAQUE (alpha ignored), MASK (cut at `alpha_cutoff`) and

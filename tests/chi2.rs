@@ -1375,3 +1375,125 @@ fn gpu_pbr_transmission_sampling() {
         check_pbr_transmission_samples(&name, &m, entering, &samples);
     }
 }
+
+// ---- The pbr stack with KHR_materials_clearcoat and KHR_materials_sheen -------------------
+
+/// (clearcoat, coat α, sheen, sheen roughness, base α) of the layered pbr tests: a smooth and
+/// a rough coat, a sheen, and both, each over a white dielectric stack.
+const PBR_LAYER_CASES: [(f32, f32, f32, f32, f32); 4] = [
+    (1.0, 0.01, 0.0, 0.0, 0.25),
+    (0.7, 0.36, 0.0, 0.0, 0.04),
+    (0.0, 0.0, 1.0, 0.5, 0.25),
+    (1.0, 0.09, 0.8, 1.0, 0.64),
+];
+
+fn pbr_layered(
+    clearcoat: f32,
+    coat_alpha: f32,
+    sheen: f32,
+    sheen_roughness: f32,
+    alpha: f32,
+) -> glint::shader_types::Material {
+    glint::shader_types::Material {
+        clearcoat,
+        clearcoat_alpha: coat_alpha,
+        sheen_color: [sheen; 3],
+        sheen_roughness,
+        ..pbr_glass([1.0; 3], alpha, 0.0)
+    }
+}
+
+/// The layered pbr sampler: a mixture of the base's visible-normal GGX lobe, the coat's, a
+/// uniform hemisphere for the sheen and the cosine lobe, with the probabilities `pbr_lobes`
+/// reports; the GGX densities are the independent reference above.
+fn check_pbr_layer_samples(name: &str, m: &glint::shader_types::Material, dirs: &[Vec3]) {
+    let (n, wo) = pbr_transmission_geometry();
+    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), true);
+    let p_s = lobes.specular_probability() as f64;
+    let p_c = lobes.coat_probability() as f64;
+    let p_h = lobes.sheen_probability() as f64;
+    assert_eq!(
+        p_c > 0.0,
+        m.clearcoat > 0.0,
+        "{name}: coat probability {p_c}"
+    );
+    assert_eq!(
+        p_h > 0.0,
+        m.sheen_color[0] > 0.0,
+        "{name}: sheen probability {p_h}"
+    );
+    let pdf = |d: Vec3| {
+        let d = d.as_dvec3().normalize();
+        let (wo, n) = (wo.as_dvec3(), n.as_dvec3());
+        let coat_alpha = (m.clearcoat_alpha as f64).max(1e-3);
+        // The GGX lobes' reflections below the surface are drawn (and absorbed) too.
+        let ggx = p_s * reference_ggx_pdf(wo, d, n, m.alpha as f64)
+            + p_c * reference_ggx_pdf(wo, d, n, coat_alpha);
+        let cos = d.dot(n);
+        if cos <= 0.0 {
+            return ggx;
+        }
+        ggx + p_h / (2.0 * PI) + (1.0 - p_s - p_c - p_h) * cos / PI
+    };
+    assert_fits(name, &directions_integrated(dirs, n, pdf, 20, 40, 48));
+}
+
+#[test]
+fn cpu_pbr_layer_sampling() {
+    let (n, wo) = pbr_transmission_geometry();
+    for (k, (coat, coat_alpha, sheen, sheen_roughness, alpha)) in
+        PBR_LAYER_CASES.into_iter().enumerate()
+    {
+        let m = pbr_layered(coat, coat_alpha, sheen, sheen_roughness, alpha);
+        let dirs: Vec<Vec3> = (0..SAMPLES)
+            .map(|i| {
+                let mut r = cpu_draws(i, SEED + 191 + k as u32);
+                let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
+                let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, true);
+                // The coat's α 0.01 lobe turns the direction's f32 rounding between frames
+                // into relative pdf differences near 1e-3.
+                if s.dir.dot(n) > 0.0 {
+                    assert!((s.pdf - pdf).abs() <= 1e-2 * pdf, "pdf {} vs {pdf}", s.pdf);
+                }
+                s.dir
+            })
+            .collect();
+        check_pbr_layer_samples(
+            &format!("cpu pbr, coat {coat} α {coat_alpha}, sheen {sheen} r {sheen_roughness}"),
+            &m,
+            &dirs,
+        );
+    }
+}
+
+/// The WGSL sampler (probe_pbr with the coat and sheen set) against the same reference.
+#[test]
+fn gpu_pbr_layer_sampling() {
+    let Some(ctx) = common::gpu() else { return };
+    let (n, wo) = pbr_transmission_geometry();
+    for (k, (coat, coat_alpha, sheen, sheen_roughness, alpha)) in
+        PBR_LAYER_CASES.into_iter().enumerate()
+    {
+        let m = pbr_layered(coat, coat_alpha, sheen, sheen_roughness, alpha);
+        let params = ProbeParams {
+            wo: wo.into(),
+            alpha,
+            ior: GLASS_IOR,
+            front_face: 1,
+            clearcoat: coat,
+            clearcoat_alpha: coat_alpha,
+            sheen,
+            sheen_roughness,
+            ..probe(n, SAMPLES, SEED + 211 + k as u32)
+        };
+        let dirs: Vec<Vec3> = run_probe(ctx, "probe_pbr", params, &empty_scene())
+            .iter()
+            .map(|s| Vec3::new(s[0], s[1], s[2]))
+            .collect();
+        check_pbr_layer_samples(
+            &format!("gpu pbr, coat {coat} α {coat_alpha}, sheen {sheen} r {sheen_roughness}"),
+            &m,
+            &dirs,
+        );
+    }
+}

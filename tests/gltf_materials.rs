@@ -140,6 +140,7 @@ fn metallic_roughness_factors_and_extensions_become_pbr() {
             transmission_texture: None,
             attenuation_color: Vec3::ONE,
             attenuation_distance: None,
+            layers: Default::default(),
         }
     );
     assert_eq!(m.color, Vec3::new(0.8, 0.5, 0.25));
@@ -164,6 +165,7 @@ fn absent_factors_take_gltfs_defaults() {
             transmission_texture: None,
             attenuation_color: Vec3::ONE,
             attenuation_distance: None,
+            layers: Default::default(),
         }
     );
     assert_eq!(m.color, Vec3::ONE);
@@ -201,6 +203,7 @@ fn transmission_and_volume_become_pbr_without_a_warning() {
             transmission_texture: None,
             attenuation_color: Vec3::new(0.9, 0.5, 0.25),
             attenuation_distance: Some(2.0),
+            layers: Default::default(),
         }
     );
     let (mut json, bin) = triangle_gltf(material);
@@ -762,4 +765,136 @@ fn unlit_materials_emit_their_base_colour() {
     json["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit"]);
     json["extensionsRequired"] = serde_json::json!(["KHR_materials_unlit"]);
     assert_eq!(render_warnings(&json, &bin), Vec::<String>::new());
+}
+
+/// KHR_materials_clearcoat and KHR_materials_sheen become the pbr material's layers, with
+/// their textures (through KHR_texture_transform like the others): the coat's red channel, the
+/// coat roughness's green, the sheen colour's RGB (sRGB) and the sheen roughness's alpha, each
+/// in the first channel the kernel reads (the colour in all three).
+#[test]
+fn clearcoat_and_sheen_become_the_pbr_materials_layers() {
+    let material = serde_json::json!({
+        "pbrMetallicRoughness": {"roughnessFactor": 0.5, "metallicFactor": 0.0},
+        "extensions": {
+            "KHR_materials_clearcoat": {
+                "clearcoatFactor": 0.8,
+                "clearcoatTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+                    "offset": [0.5, 0.0]
+                }}},
+                "clearcoatRoughnessFactor": 0.3,
+                "clearcoatRoughnessTexture": {"index": 1}
+            },
+            "KHR_materials_sheen": {
+                "sheenColorFactor": [0.5, 0.25, 1.0],
+                "sheenColorTexture": {"index": 0},
+                "sheenRoughnessFactor": 0.6,
+                "sheenRoughnessTexture": {"index": 2}
+            }
+        }
+    });
+    let rgba = rgba_png([[0, 0, 0, 255], [0, 0, 0, 128], [0, 0, 0, 51], [0, 0, 0, 0]]);
+    let bytes = glb(
+        material,
+        &[png(COLOR_TEXELS), png(METALLIC_ROUGHNESS_TEXELS), rgba],
+        |g| {
+            g["textures"] = serde_json::json!([{"source": 0}, {"source": 1}, {"source": 2}]);
+            g["extensionsUsed"] = serde_json::json!([
+                "KHR_materials_clearcoat",
+                "KHR_materials_sheen",
+                "KHR_texture_transform"
+            ]);
+            g["extensionsRequired"] =
+                serde_json::json!(["KHR_materials_clearcoat", "KHR_materials_sheen"]);
+        },
+    );
+    let scene = load_glb(&bytes).unwrap_or_else(|e| panic!("{e}"));
+    let index = scene.triangles[0].material as usize;
+    let MaterialKind::Pbr { layers, .. } = scene.materials[index].kind else {
+        panic!("{:?}", scene.materials[index].kind)
+    };
+    assert_eq!((layers.clearcoat, layers.clearcoat_roughness), (0.8, 0.3));
+    assert_eq!(
+        (layers.sheen_color, layers.sheen_roughness),
+        (Vec3::new(0.5, 0.25, 1.0), 0.6)
+    );
+    assert_eq!(layers.clearcoat_normal_texture, None);
+    let k = scene.kernel_scene();
+    let m = k.materials[index];
+    assert_eq!((m.clearcoat, m.sheen_roughness), (0.8, 0.6));
+    assert!((m.clearcoat_alpha - 0.09).abs() < 1e-7);
+    assert_eq!(m.sheen_color, [0.5, 0.25, 1.0]);
+    // The first texel each texture holds is the image's bottom-left (texels[2]).
+    let first = |t: u32| k.texels[k.textures[t as usize].first_texel as usize];
+    assert_eq!(first(m.clearcoat_texture)[0], 0.0, "red of (0, 0, 255)");
+    assert_eq!(
+        first(m.clearcoat_roughness_texture)[0],
+        0.0,
+        "green of (9, 0, 64)"
+    );
+    assert!((first(m.sheen_roughness_texture)[0] - 51.0 / 255.0).abs() < 1e-6);
+    assert_eq!(
+        first(m.sheen_color_texture)[2],
+        1.0,
+        "blue of (0, 0, 255), sRGB"
+    );
+    // The transform reached the coat's texture and no other.
+    let transform = |t: u32| k.textures[t as usize].transform_u;
+    assert_eq!(transform(m.clearcoat_texture), [1.0, 0.0, 0.5]);
+    assert_eq!(transform(m.sheen_color_texture), [1.0, 0.0, 0.0]);
+}
+
+/// Both extensions are read: a file that uses (and requires) them renders without a warning
+/// about them.
+#[test]
+fn clearcoat_and_sheen_render_without_a_warning() {
+    let (mut json, bin) = triangle_gltf(serde_json::json!({"extensions": {
+        "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatRoughnessFactor": 0.2},
+        "KHR_materials_sheen": {"sheenColorFactor": [1.0, 0.5, 0.5], "sheenRoughnessFactor": 0.5}
+    }}));
+    json["extensionsUsed"] = serde_json::json!(["KHR_materials_clearcoat", "KHR_materials_sheen"]);
+    json["extensionsRequired"] = json["extensionsUsed"].clone();
+    let warnings = render_warnings(&json, &bin);
+    assert!(
+        !warnings
+            .iter()
+            .any(|w| w.contains("clearcoat") || w.contains("sheen")),
+        "{warnings:?}"
+    );
+}
+
+/// Out-of-range or malformed clearcoat and sheen values are errors naming the material and the
+/// field.
+#[test]
+fn bad_clearcoat_and_sheen_values_are_named_errors() {
+    for (extension, needles) in [
+        (
+            serde_json::json!({"KHR_materials_clearcoat": {"clearcoatFactor": 1.5}}),
+            &["material0", "clearcoatFactor must be in [0, 1]", "1.5"][..],
+        ),
+        (
+            serde_json::json!({"KHR_materials_clearcoat": {"clearcoatRoughnessFactor": -0.5}}),
+            &["material0", "clearcoatRoughnessFactor must be in [0, 1]"][..],
+        ),
+        (
+            serde_json::json!({"KHR_materials_clearcoat": {"clearcoatFactor": "thick"}}),
+            &["materials[0].extensions.KHR_materials_clearcoat"][..],
+        ),
+        (
+            serde_json::json!({"KHR_materials_sheen": {"sheenColorFactor": [2.0, 0.0, 0.0]}}),
+            &["material0", "sheenColorFactor must be in [0, 1]"][..],
+        ),
+        (
+            serde_json::json!({"KHR_materials_sheen": {"sheenRoughnessFactor": 3.0}}),
+            &["material0", "sheenRoughnessFactor must be in [0, 1]", "3"][..],
+        ),
+        (
+            serde_json::json!({"KHR_materials_sheen": {
+                "sheenColorFactor": [1.0, 1.0, 1.0],
+                "sheenColorTexture": {"index": 7}
+            }}),
+            &["materials[0].extensions.KHR_materials_sheen"][..],
+        ),
+    ] {
+        assert_material_refused(serde_json::json!({ "extensions": extension }), needles);
+    }
 }

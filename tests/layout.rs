@@ -165,7 +165,17 @@ fn rust_structs_match_wgsl_layout() {
             transmission,
             transmission_texture,
             attenuation_color,
-            attenuation_distance
+            attenuation_distance,
+            clearcoat,
+            clearcoat_alpha,
+            clearcoat_texture,
+            clearcoat_roughness_texture,
+            clearcoat_normal_texture,
+            clearcoat_normal_scale,
+            sheen_roughness,
+            sheen_color_texture,
+            sheen_color,
+            sheen_roughness_texture
         ]
     );
     assert_same_layout!(
@@ -231,10 +241,10 @@ fn rust_structs_match_wgsl_layout() {
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
     assert_same_layout!(&module, TriangleTangents, "TriangleTangents", [t0, t1, t2]);
-    // Seven vec4s: glTF's emissive and normal textures took the fifth, alpha and transmission
-    // the sixth, volume attenuation the seventh (a uniform-bound scene's materials stay far
-    // below the uniform limit).
-    assert_eq!(size_of::<Material>(), 112, "Material stays 112 bytes");
+    // Ten vec4s: glTF's emissive and normal textures took the fifth, alpha and transmission
+    // the sixth, volume attenuation the seventh, clearcoat the eighth and part of the ninth,
+    // sheen the rest (a uniform-bound scene's materials stay far below the uniform limit).
+    assert_eq!(size_of::<Material>(), 160, "Material stays 160 bytes");
     assert_same_layout!(
         &module,
         EnvironmentTexel,
@@ -375,6 +385,9 @@ fn every_feature_combination_validates() {
             pbr: (bits.count_ones() / 2) % 2 == 1,
             // Likewise: on with pbr in some combinations and without it in others.
             transmission: (bits / 3) % 2 == 1,
+            // Likewise, the coat and the sheen, each with and without pbr and the other.
+            clearcoat: (bits / 7) % 2 == 1,
+            sheen: (bits / 11) % 2 == 1,
             volume: (bits / 5) % 2 == 1,
             // Likewise: on in half the combinations, with and without textures and triangles.
             alpha: (bits * 5 / 3) % 2 == 1,
@@ -409,6 +422,8 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         dielectric: false,
         pbr: false,
         transmission: false,
+        clearcoat: false,
+        sheen: false,
         volume: false,
         aovs: false,
         textures: false,

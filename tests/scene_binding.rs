@@ -181,7 +181,8 @@ fn bvh_top_nodes_in_a_uniform_buffer_do_not_change_the_image() {
 /// Kernels with unused features compiled out render exactly what the kernel with everything
 /// renders: the flags only remove code a scene cannot reach. The scenes cover each flag both
 /// ways: light sampling on and off; quad emitters only, sphere emitters only, and both; metal
-/// and glass present and absent; transmission and volumes (the pbr grid) present and absent.
+/// and glass present and absent; transmission, volumes, clearcoat and sheen (the pbr grid)
+/// present and absent.
 #[test]
 fn compiled_out_features_do_not_change_the_image() {
     let Some(ctx) = gpu() else { return };
@@ -244,9 +245,11 @@ fn compiled_out_features_do_not_change_the_image() {
             f.sun_disks,
             f.transmission,
             f.volume,
+            f.clearcoat,
+            f.sheen,
         ]
     };
-    for i in 0..10 {
+    for i in 0..12 {
         assert!(
             variants_seen.iter().any(|f| flags(f)[i]),
             "flag {i} never on"

@@ -20,22 +20,36 @@
 //!   which is (1 − T) · (the stack above) + T · (the rough dielectric of `rough_dielectric.rs`,
 //!   its refraction tinted by the base colour), T the transmission. The rough dielectric has
 //!   the exact Fresnel term of the ior (it decides total internal reflection from inside) and
-//!   no energy compensation; KHR_materials_specular does not change it.
+//!   its own energy compensation (`dielectric_energy.rs`); KHR_materials_specular does not
+//!   change it.
+//!
+//! - Over all that, KHR_materials_sheen's sheen (`sheen.rs`) and over that KHR_materials_
+//!   clearcoat's coat (`clearcoat.rs`), as the extensions stack them: f = coat + below_coat ·
+//!   (sheen + below_sheen · base), each `below` its layer's albedo scaling. Refraction, which
+//!   leaves below the surface, keeps the layers' shares at μo.
 //!
 //! The tables E, Es are looked up in `ggx_energy.rs`. Sampling picks the transmission lobe,
-//! the specular lobe (visible normals) or a cosine lobe (for the diffuse and
-//! multiple-scattering lobes) with probabilities from their albedos at μo, and weights by the
-//! mixture pdf, which MIS uses too. Refracted samples are marked delta: shadow rays do not
+//! the specular lobe (visible normals), the coat's lobe (visible normals), the sheen's
+//! (uniform) or a cosine lobe (for the diffuse and multiple-scattering lobes) with
+//! probabilities from their albedos at μo, and weights by the mixture pdf, which MIS uses
+//! too. Refracted samples are marked delta: shadow rays do not
 //! pass through surfaces, so light sampling cannot find what lies behind one, and what such a
 //! sample reaches must count in full.
 
 use super::bsdf::BsdfSample;
+use super::clearcoat::{
+    clearcoat_eval, clearcoat_lobe, clearcoat_transmitted_o, ClearcoatLobe, NO_CLEARCOAT,
+};
 use super::diffuse::sample_cosine_hemisphere;
 use super::frame::{from_local, to_local, PI};
 use super::ggx_energy::{ggx_albedo, ggx_albedo_average};
 use super::microfacet::{ggx_d, ggx_lambda, ggx_reflection_pdf, sample_ggx_visible_normal};
 use super::rough_dielectric::{
     rough_dielectric_eval, rough_dielectric_pdf, rough_dielectric_sample,
+};
+use super::sheen::{
+    sample_uniform_hemisphere, sheen_eval, sheen_lobe, sheen_transmitted_o, SheenLobe, NO_SHEEN,
+    UNIFORM_HEMISPHERE_PDF,
 };
 use crate::shader_types::Material;
 use glam::Vec3;
@@ -46,6 +60,9 @@ pub const PBR_MIN_ALPHA: f32 = 1e-3;
 
 /// Bounds of the probability of sampling the specular lobe, so neither strategy starves.
 const MIN_LOBE_PROBABILITY: f32 = 0.1;
+/// The most the coat's and the sheen's lobes are each sampled with, so the stack below them
+/// keeps at least 1 − 2 · 0.45 of the samples.
+const MAX_LAYER_PROBABILITY: f32 = 0.45;
 
 /// What the lobes need at one shading point, from the material and μo.
 #[derive(Clone, Copy, Debug)]
@@ -71,6 +88,13 @@ pub struct PbrLobes {
     /// has the rest).
     specular_probability: f32,
     transmission_probability: f32,
+    /// The coat and the sheen (zero weight and black where the material has none), the
+    /// probabilities of sampling their lobes, and the share of light from wo that passes both.
+    coat: ClearcoatLobe,
+    sheen: SheenLobe,
+    coat_probability: f32,
+    sheen_probability: f32,
+    layers_o: f32,
 }
 
 fn average(v: Vec3) -> f32 {
@@ -92,6 +116,15 @@ impl PbrLobes {
     /// The probability with which [`pbr_sample`] samples the transmission lobe.
     pub fn transmission_probability(&self) -> f32 {
         self.transmission_probability
+    }
+
+    /// The probabilities with which [`pbr_sample`] samples the coat's and the sheen's lobes.
+    pub fn coat_probability(&self) -> f32 {
+        self.coat_probability
+    }
+
+    pub fn sheen_probability(&self) -> f32 {
+        self.sheen_probability
     }
 }
 
@@ -139,6 +172,42 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
     } else {
         0.5
     };
+    let mut specular_probability = (1.0 - transmission_probability) * specular_share;
+    let mut transmission_probability = transmission_probability;
+    // The layers on top: their lobes take shares of the samples by their albedos at μo
+    // against the stack's (which they dim), each within [0.1, 0.45] when present.
+    // Only materials with a coat or a sheen read their tables.
+    let coat = if m.clearcoat > 0.0 {
+        clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, mu_o)
+    } else {
+        NO_CLEARCOAT
+    };
+    let sheen_color = Vec3::from(m.sheen_color);
+    let sheen = if sheen_color.max_element() > 0.0 {
+        sheen_lobe(sheen_color, m.sheen_roughness, mu_o)
+    } else {
+        NO_SHEEN
+    };
+    let below_coat = clearcoat_transmitted_o(&coat);
+    let layers_o = below_coat * sheen_transmitted_o(&sheen);
+    let (mut coat_probability, mut sheen_probability) = (0.0, 0.0);
+    if coat.weight > 0.0 || sheen.color.max_element() > 0.0 {
+        let coat_weight = coat.specular_albedo_o;
+        let sheen_weight = below_coat * sheen.albedo_o;
+        let all = coat_weight + sheen_weight + coat.ms_albedo_o + layers_o * total;
+        let share = |weight: f32, present: bool| {
+            if present && all > 0.0 {
+                (weight / all).clamp(MIN_LOBE_PROBABILITY, MAX_LAYER_PROBABILITY)
+            } else {
+                0.0
+            }
+        };
+        coat_probability = share(coat_weight, coat.weight > 0.0);
+        sheen_probability = share(sheen_weight, sheen.color.max_element() > 0.0);
+        let rest = 1.0 - coat_probability - sheen_probability;
+        specular_probability *= rest;
+        transmission_probability *= rest;
+    }
     PbrLobes {
         base,
         metallic,
@@ -153,8 +222,13 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
         layer_average,
         transmission,
         etap: if front_face { m.ior } else { 1.0 / m.ior },
-        specular_probability: (1.0 - transmission_probability) * specular_share,
+        specular_probability,
         transmission_probability,
+        coat,
+        sheen,
+        coat_probability,
+        sheen_probability,
+        layers_o,
     }
 }
 
@@ -170,7 +244,8 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
         if transmissive <= 0.0 {
             return Vec3::ZERO;
         }
-        return l.base * (transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+        return l.base
+            * (transmissive * l.layers_o * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }
     let opaque = (1.0 - l.metallic) * (1.0 - l.transmission);
     let h = (wo + wi).normalize();
@@ -183,7 +258,10 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
     let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
     let (a_i, b_i) = ggx_albedo(wi.z, l.alpha);
     let e_i = a_i + b_i;
-    let mut out = specular;
+    // The specular lobes (GGX, and the transmission lobe's reflection) apart from the broad
+    // ones: the coat scales them as narrow lobes (clearcoat.rs).
+    let mut narrow = specular;
+    let mut out = Vec3::ZERO;
     if l.e_average < 1.0 {
         let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
         out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
@@ -211,9 +289,18 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
     );
     out += opaque * l.base * base_weight * (wi.z / PI);
     if transmissive > 0.0 {
-        out += Vec3::splat(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+        narrow += Vec3::splat(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }
-    out
+    if l.sheen.color.max_element() > 0.0 {
+        let (sheen, below) = sheen_eval(&l.sheen, wo, wi);
+        out = sheen + below * out;
+        narrow *= below;
+    }
+    if l.coat.weight > 0.0 {
+        let coat = clearcoat_eval(&l.coat, wo, wi);
+        return Vec3::splat(coat.f_cos) + coat.below_broad * out + coat.below_narrow * narrow;
+    }
+    out + narrow
 }
 
 /// The mixture pdf of [`pbr_sample`]; wo and wi in the local frame.
@@ -227,8 +314,13 @@ pub fn pbr_pdf(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> f32 {
         pdf = p_transmission * rough_dielectric_pdf(lobes.alpha, lobes.etap, wo, wi);
     }
     if wi.z > 0.0 {
+        let (p_coat, p_sheen) = (lobes.coat_probability, lobes.sheen_probability);
         pdf += p_specular * ggx_reflection_pdf(wo, wi, lobes.alpha)
-            + (1.0 - p_specular - p_transmission) * (wi.z / PI);
+            + (1.0 - p_specular - p_transmission - p_coat - p_sheen) * (wi.z / PI);
+        if p_coat > 0.0 {
+            pdf += p_coat * ggx_reflection_pdf(wo, wi, lobes.coat.alpha);
+        }
+        pdf += p_sheen * UNIFORM_HEMISPHERE_PDF;
     }
     pdf
 }
@@ -245,7 +337,7 @@ pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32
             // Only the transmission lobe reaches below: the mixture's f cos / pdf is the
             // lobe's own weight times its share over its probability (and at ior 1, where the
             // lobe is a delta, this stays finite where f and pdf do not).
-            let share = (1.0 - l.metallic) * l.transmission / p_transmission;
+            let share = (1.0 - l.metallic) * l.transmission * l.layers_o / p_transmission;
             return BsdfSample {
                 dir,
                 weight: l.base * (s.weight * share),
@@ -257,6 +349,15 @@ pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32
     } else if choice < p_transmission + lobes.specular_probability {
         let h = sample_ggx_visible_normal(wo_l, lobes.alpha, u);
         let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
+        (from_local(wi_l, n).normalize(), wi_l)
+    } else if choice < p_transmission + lobes.specular_probability + l.coat_probability {
+        let h = sample_ggx_visible_normal(wo_l, l.coat.alpha, u);
+        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
+        (from_local(wi_l, n).normalize(), wi_l)
+    } else if choice
+        < p_transmission + lobes.specular_probability + l.coat_probability + l.sheen_probability
+    {
+        let wi_l = sample_uniform_hemisphere(u);
         (from_local(wi_l, n).normalize(), wi_l)
     } else {
         let dir = sample_cosine_hemisphere(n, u);

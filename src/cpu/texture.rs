@@ -206,6 +206,26 @@ pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
         // glTF's transmissionTexture: its R channel multiplies the factor.
         out.transmission = m.transmission * texture_lookup(textures, m.transmission_texture, uv).x;
     }
+    // KHR_materials_clearcoat's textures: R multiplies the factor, G the roughness (the loader
+    // puts it in x, as a metallic-roughness texture's).
+    if m.clearcoat_texture != NO_TEXTURE {
+        out.clearcoat = m.clearcoat * texture_lookup(textures, m.clearcoat_texture, uv).x;
+    }
+    if m.clearcoat_roughness_texture != NO_TEXTURE {
+        let r = texture_lookup(textures, m.clearcoat_roughness_texture, uv).x;
+        out.clearcoat_alpha = m.clearcoat_alpha * (r * r);
+    }
+    // KHR_materials_sheen's: RGB multiplies the colour; the roughness (the image's alpha,
+    // moved to x by the loader) the roughness.
+    if m.sheen_color_texture != NO_TEXTURE {
+        out.sheen_color = (Vec3::from(m.sheen_color)
+            * texture_lookup(textures, m.sheen_color_texture, uv))
+        .into();
+    }
+    if m.sheen_roughness_texture != NO_TEXTURE {
+        out.sheen_roughness =
+            m.sheen_roughness * texture_lookup(textures, m.sheen_roughness_texture, uv).x;
+    }
     out.emission = emission_at(textures, m, uv).into();
     out
 }

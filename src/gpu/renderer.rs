@@ -370,6 +370,13 @@ impl<'a> GpuRenderer<'a> {
             &[]
         };
         let dielectric_energy = storage_buffer(ctx, "dielectric energy tables", dielectric_energy);
+        // The sheen's albedo table (src/sheen_energy.rs), a placeholder without a sheen.
+        let sheen_energy: &[f32] = if variant.features.pbr && variant.features.sheen {
+            crate::sheen_energy::sheen_energy_table()
+        } else {
+            &[]
+        };
+        let sheen_energy = storage_buffer(ctx, "sheen energy table", sheen_energy);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -448,6 +455,7 @@ impl<'a> GpuRenderer<'a> {
             (24, read_only, &lights),
             (25, read_only, &ggx_energy),
             (33, read_only, &dielectric_energy),
+            (32, read_only, &sheen_energy),
         ]
         .into_iter()
         .chain(hardware_buffers)

@@ -115,6 +115,12 @@ pub(super) struct MaterialToml {
     pub(super) transmission: Option<S<Real>>,
     pub(super) attenuation_color: Option<S<Triple>>,
     pub(super) attenuation_distance: Option<S<Real>>,
+    /// KHR_materials_clearcoat and KHR_materials_sheen, for `type = "pbr"`: each a constant or
+    /// a texture.
+    pub(super) clearcoat: Option<S<RoughnessToml>>,
+    pub(super) clearcoat_roughness: Option<S<RoughnessToml>>,
+    pub(super) sheen_color: Option<S<Triple>>,
+    pub(super) sheen_roughness: Option<S<RoughnessToml>>,
     /// Any type, on meshes: `"opaque"` (the default), `"mask"` or `"blend"` (glTF's alphaMode),
     /// the constant `alpha` (which a colour texture's alpha multiplies) and the mask's
     /// `alpha_cutoff`.

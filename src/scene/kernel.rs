@@ -229,6 +229,7 @@ impl Scene {
                 // No transmission nor attenuation but where a pbr material asks for them.
                 let (mut transmission, mut transmission_texture) = (0.0, NO_TEXTURE);
                 let (mut attenuation_color, mut attenuation_distance) = (Vec3::ONE, 0.0);
+                let mut layers = super::PbrLayers::default();
                 let (kind, alpha, ior) = match m.kind {
                     MaterialKind::Diffuse => (MATERIAL_DIFFUSE, 0.0, 1.0),
                     MaterialKind::Specular => (MATERIAL_SPECULAR, 0.0, 1.0),
@@ -246,7 +247,9 @@ impl Scene {
                         transmission_texture: t_texture,
                         attenuation_color: a_color,
                         attenuation_distance: a_distance,
+                        layers: l,
                     } => {
+                        layers = l;
                         (metallic, specular, specular_color) = (m, s, c);
                         (transmission, transmission_texture) = (t, t_texture.unwrap_or(NO_TEXTURE));
                         if let Some(d) = a_distance {
@@ -284,6 +287,20 @@ impl Scene {
                     transmission_texture,
                     attenuation_color: attenuation_color.into(),
                     attenuation_distance,
+                    clearcoat: layers.clearcoat,
+                    clearcoat_alpha: layers.clearcoat_roughness * layers.clearcoat_roughness,
+                    clearcoat_texture: layers.clearcoat_texture.unwrap_or(NO_TEXTURE),
+                    clearcoat_roughness_texture: layers
+                        .clearcoat_roughness_texture
+                        .unwrap_or(NO_TEXTURE),
+                    clearcoat_normal_texture: layers
+                        .clearcoat_normal_texture
+                        .map_or(NO_TEXTURE, |(t, _)| t),
+                    clearcoat_normal_scale: layers.clearcoat_normal_texture.map_or(1.0, |(_, s)| s),
+                    sheen_roughness: layers.sheen_roughness,
+                    sheen_color_texture: layers.sheen_color_texture.unwrap_or(NO_TEXTURE),
+                    sheen_color: layers.sheen_color.into(),
+                    sheen_roughness_texture: layers.sheen_roughness_texture.unwrap_or(NO_TEXTURE),
                 }
             })
             .collect();

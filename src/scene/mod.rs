@@ -179,7 +179,29 @@ pub enum MaterialKind {
         /// light has after `attenuation_distance`; None for none (glTF's +∞).
         attenuation_color: Vec3,
         attenuation_distance: Option<f32>,
+        /// KHR_materials_clearcoat and KHR_materials_sheen on top.
+        layers: PbrLayers,
     },
+}
+
+/// KHR_materials_clearcoat's coat and KHR_materials_sheen's sheen on a pbr material
+/// (`src/cpu/clearcoat.rs`, `src/cpu/sheen.rs`); the default has neither. Textures are
+/// indices into [`Scene::textures`]: the coat's first channel multiplies `clearcoat`, the
+/// coat roughness's first channel `clearcoat_roughness`, the sheen colour's RGB `sheen_color`,
+/// the sheen roughness's first channel `sheen_roughness`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PbrLayers {
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
+    pub clearcoat_texture: Option<u32>,
+    pub clearcoat_roughness_texture: Option<u32>,
+    /// The coat's normal map and its scale.
+    pub clearcoat_normal_texture: Option<(u32, f32)>,
+    /// Black: no sheen.
+    pub sheen_color: Vec3,
+    pub sheen_roughness: f32,
+    pub sheen_color_texture: Option<u32>,
+    pub sheen_roughness_texture: Option<u32>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -52,6 +52,9 @@ pub enum TextureUse {
     /// OBJ's separate `map_Pr` and `map_Pm` images merged into one on load
     /// ([`TextureSet::roughness_and_metallic`]): roughness in red, metallic in green.
     RoughnessAndMetallic,
+    /// glTF's sheenRoughnessTexture: linear, the roughness in its alpha channel (1 where the
+    /// file has none) in [0, 1], moved to the first channel as the kernel reads it.
+    SheenRoughness,
 }
 
 /// Every texture of a scene, as the kernel reads them.
@@ -204,6 +207,7 @@ impl TextureSet {
             TextureUse::Roughness | TextureUse::Transmission => 0..1,
             TextureUse::MetallicRoughness => 1..3,
             TextureUse::RoughnessAndMetallic => 0..2,
+            TextureUse::SheenRoughness => 0..0,
         };
         // Rows from the top (as files store them) to rows from the bottom.
         for y in 0..image.height {
@@ -211,7 +215,9 @@ impl TextureSet {
                 let texel = image.texel(x, image.height - 1 - y);
                 // A colour texture's alpha is read too (alpha-tested and blended materials).
                 let alpha = match usage {
-                    TextureUse::Color => Some(image.alpha(x, image.height - 1 - y)),
+                    TextureUse::Color | TextureUse::SheenRoughness => {
+                        Some(image.alpha(x, image.height - 1 - y))
+                    }
                     _ => None,
                 };
                 if let Some(&bad) = texel[channels.clone()]
@@ -230,6 +236,7 @@ impl TextureSet {
                             TextureUse::RoughnessAndMetallic => "roughness or metallic",
                             TextureUse::Normal => "normal",
                             TextureUse::Transmission => "transmission",
+                            TextureUse::SheenRoughness => "sheen roughness",
                         }
                     ));
                 }
@@ -255,6 +262,7 @@ impl TextureSet {
                     TextureUse::Roughness | TextureUse::Transmission => [r, 1.0, 1.0, 0.0],
                     TextureUse::MetallicRoughness => [g, b, 1.0, 0.0],
                     TextureUse::RoughnessAndMetallic => [r, g, 1.0, 0.0],
+                    TextureUse::SheenRoughness => [image.alpha(x, y), 1.0, 1.0, 0.0],
                 });
             }
         }
@@ -309,6 +317,7 @@ fn encoding(usage: TextureUse) -> Encoding {
         | TextureUse::MetallicRoughness
         | TextureUse::Normal
         | TextureUse::Transmission
-        | TextureUse::RoughnessAndMetallic => Encoding::Linear,
+        | TextureUse::RoughnessAndMetallic
+        | TextureUse::SheenRoughness => Encoding::Linear,
     }
 }

@@ -23,8 +23,13 @@ pub struct ProbeParams {
     pub side_probe: [f32; 3],
     pub ior: f32,
     pub front_face: u32,
-    /// The pbr material's transmission (probe_pbr).
+    /// The pbr material's transmission, coat (weight, α) and white sheen (its colour's value,
+    /// roughness) (probe_pbr).
     pub transmission: f32,
+    pub clearcoat: f32,
+    pub clearcoat_alpha: f32,
+    pub sheen: f32,
+    pub sheen_roughness: f32,
     pub _pad: [u32; 2],
 }
 
@@ -138,6 +143,11 @@ fn run_probe_with(
         "dielectric energy",
         glint::dielectric_energy::dielectric_energy_table(),
     );
+    let sheen_energy = storage_buffer(
+        ctx,
+        "sheen energy",
+        glint::sheen_energy::sheen_energy_table(),
+    );
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("probe out"),
@@ -183,6 +193,7 @@ fn run_probe_with(
             (24, read_only, &lights),
             (25, read_only, &ggx_energy),
             (33, read_only, &dielectric_energy),
+            (32, read_only, &sheen_energy),
         ]
         .into_iter()
         .chain(hardware)

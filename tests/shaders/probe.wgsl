@@ -13,8 +13,13 @@ struct ProbeParams {
     side_probe: vec3<f32>,
     ior: f32,
     front_face: u32,
-    // The pbr material's transmission (probe_pbr).
+    // The pbr material's transmission, coat (weight, alpha) and white sheen (its colour's
+    // value, roughness) (probe_pbr).
     transmission: f32,
+    clearcoat: f32,
+    clearcoat_alpha: f32,
+    sheen: f32,
+    sheen_roughness: f32,
 }
 
 @group(0) @binding(10) var<uniform> probe: ProbeParams;
@@ -83,6 +88,10 @@ fn probe_pbr(@builtin(global_invocation_id) id: vec3<u32>) {
     m.specular = 1.0;
     m.specular_color = vec3<f32>(1.0);
     m.transmission = probe.transmission;
+    m.clearcoat = probe.clearcoat;
+    m.clearcoat_alpha = probe.clearcoat_alpha;
+    m.sheen_color = vec3<f32>(probe.sheen);
+    m.sheen_roughness = probe.sheen_roughness;
     let s = bsdf_sample(m, probe.wo, probe.normal, probe.front_face != 0u, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }

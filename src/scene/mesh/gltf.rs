@@ -32,8 +32,10 @@ use std::rc::Rc;
 
 /// Extensions a file may require: glint reads them (the material ones in part, see README.md).
 const REQUIRABLE_EXTENSIONS: &[&str] = &[
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_sheen",
     "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_materials_unlit",
@@ -47,7 +49,9 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
 /// cannot trace the ray through the mesh: glint does, and ignores them.)
 const FULLY_READ_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
+    "KHR_materials_sheen",
     "KHR_materials_transmission",
     "KHR_materials_unlit",
     "KHR_materials_volume",
@@ -117,6 +121,10 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
                 None => None,
             },
             roughness_and_metallic: None,
+            clearcoat: source(maps.clearcoat)?,
+            clearcoat_roughness: source(maps.clearcoat_roughness)?,
+            sheen_color: source(maps.sheen_color)?,
+            sheen_roughness: source(maps.sheen_roughness)?,
         });
         materials.push(material);
         has_other_textures |= other_textures;

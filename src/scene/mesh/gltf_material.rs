@@ -5,12 +5,52 @@
 use super::gltf::exists;
 use super::{check_emission, check_ior, check_reflectance};
 use crate::scene::texture::Sampling;
-use crate::scene::{Alpha, AlphaMode, Material, MaterialKind};
+use crate::scene::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
 use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use glam::Vec3;
 use gltf::json;
 use json::texture::{MagFilter, WrappingMode};
 use json::validation::Checked;
+use serde::Deserialize;
+
+/// KHR_materials_clearcoat as the file holds it (the gltf crate does not parse it), with the
+/// extension's defaults.
+#[derive(Deserialize, Default)]
+#[serde(rename_all = "camelCase", default)]
+struct ClearcoatJson {
+    clearcoat_factor: f32,
+    clearcoat_texture: Option<json::texture::Info>,
+    clearcoat_roughness_factor: f32,
+    clearcoat_roughness_texture: Option<json::texture::Info>,
+    clearcoat_normal_texture: Option<json::material::NormalTexture>,
+}
+
+/// KHR_materials_sheen as the file holds it, with the extension's defaults.
+#[derive(Deserialize, Default)]
+#[serde(rename_all = "camelCase", default)]
+struct SheenJson {
+    sheen_color_factor: [f32; 3],
+    sheen_color_texture: Option<json::texture::Info>,
+    sheen_roughness_factor: f32,
+    sheen_roughness_texture: Option<json::texture::Info>,
+}
+
+/// Extension `name` of material `index`, parsed from the raw JSON; a malformed one is an error
+/// naming the material.
+fn raw_extension<T: for<'de> Deserialize<'de>>(
+    m: &json::Material,
+    index: usize,
+    name: &str,
+) -> Result<Option<T>, String> {
+    m.extensions
+        .as_ref()
+        .and_then(|e| e.others.get(name))
+        .map(|v| {
+            serde_json::from_value(v.clone())
+                .map_err(|e| format!("materials[{index}].extensions.{name}: {e}"))
+        })
+        .transpose()
+}
 
 /// A glTF material as glint's, its colour texture's file, and whether it has other textures:
 /// `pbrMetallicRoughness` (baseColorFactor, metallicFactor, roughnessFactor, with glTF's
@@ -18,7 +58,8 @@ use json::validation::Checked;
 /// KHR_materials_transmission (factor and texture) and KHR_materials_volume
 /// (attenuationColor, attenuationDistance) → `pbr`; emissiveFactor ×
 /// KHR_materials_emissive_strength → emission; alphaMode, alphaCutoff and baseColorFactor's
-/// alpha → alpha. Warning lines go to `warnings`.
+/// alpha → alpha; KHR_materials_clearcoat and KHR_materials_sheen (factors and textures) →
+/// the pbr material's layers. Warning lines go to `warnings`.
 pub(super) fn material(
     root: &json::Root,
     m: &json::Material,
@@ -37,6 +78,8 @@ pub(super) fn material(
         .filter(|&n| n > 0.0)
         .unwrap_or(1.5);
     let ior = check_ior(&name, "KHR_materials_ior", ior)?;
+    let clearcoat: Option<ClearcoatJson> = raw_extension(m, index, "KHR_materials_clearcoat")?;
+    let sheen: Option<SheenJson> = raw_extension(m, index, "KHR_materials_sheen")?;
     let kind = {
         let unit = |what: &str, v: f32| {
             if (0.0..=1.0).contains(&v) {
@@ -72,6 +115,31 @@ pub(super) fn material(
             }
             None => None,
         };
+        let mut layers = PbrLayers::default();
+        if let Some(c) = &clearcoat {
+            layers.clearcoat = unit(
+                "KHR_materials_clearcoat clearcoatFactor",
+                c.clearcoat_factor,
+            )?;
+            layers.clearcoat_roughness = unit(
+                "KHR_materials_clearcoat clearcoatRoughnessFactor",
+                c.clearcoat_roughness_factor,
+            )?;
+        }
+        if let Some(s) = &sheen {
+            let color = Vec3::from(s.sheen_color_factor);
+            if !color.is_finite() || color.min_element() < 0.0 || color.max_element() > 1.0 {
+                return Err(format!(
+                    "material {name:?}: KHR_materials_sheen sheenColorFactor must be in [0, 1], \
+                     got {color}"
+                ));
+            }
+            layers.sheen_color = color;
+            layers.sheen_roughness = unit(
+                "KHR_materials_sheen sheenRoughnessFactor",
+                s.sheen_roughness_factor,
+            )?;
+        }
         MaterialKind::Pbr {
             roughness: unit("roughnessFactor", pbr.roughness_factor.0)?,
             metallic: unit("metallicFactor", pbr.metallic_factor.0)?,
@@ -88,6 +156,7 @@ pub(super) fn material(
             transmission_texture: None,
             attenuation_color,
             attenuation_distance,
+            layers,
         }
     };
     let color = check_reflectance(
@@ -227,7 +296,51 @@ pub(super) fn material(
             }
             None => None,
         },
+        // Textures of a layer whose factor is 0 multiply nothing.
+        clearcoat: match &clearcoat {
+            Some(c) if c.clearcoat_factor > 0.0 => image(
+                &c.clearcoat_texture,
+                "extensions.KHR_materials_clearcoat.clearcoatTexture",
+            )?,
+            _ => None,
+        },
+        clearcoat_roughness: match &clearcoat {
+            Some(c) if c.clearcoat_factor > 0.0 => image(
+                &c.clearcoat_roughness_texture,
+                "extensions.KHR_materials_clearcoat.clearcoatRoughnessTexture",
+            )?,
+            _ => None,
+        },
+        sheen_color: match &sheen {
+            Some(s) if s.sheen_color_factor.iter().any(|&c| c > 0.0) => image(
+                &s.sheen_color_texture,
+                "extensions.KHR_materials_sheen.sheenColorTexture",
+            )?,
+            _ => None,
+        },
+        sheen_roughness: match &sheen {
+            Some(s) if s.sheen_color_factor.iter().any(|&c| c > 0.0) => image(
+                &s.sheen_roughness_texture,
+                "extensions.KHR_materials_sheen.sheenRoughnessTexture",
+            )?,
+            _ => None,
+        },
     };
+    // The coat's own normal map is not rendered yet: the coat takes the base's shading normal.
+    if let Some(c) = clearcoat.as_ref().filter(|c| c.clearcoat_factor > 0.0) {
+        if let Some(n) = &c.clearcoat_normal_texture {
+            if !n.scale.is_finite() {
+                return Err(format!(
+                    "materials[{index}].extensions.KHR_materials_clearcoat.clearcoatNormalTexture.\
+                     scale: not finite"
+                ));
+            }
+            warnings.push(format!(
+                "materials[{index}]: KHR_materials_clearcoat's clearcoatNormalTexture is not \
+                 rendered; the coat follows the base's shading normal"
+            ));
+        }
+    }
     if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
         other_textures |=
             specular.specular_texture.is_some() || specular.specular_color_texture.is_some();
@@ -256,6 +369,10 @@ pub(super) fn material(
                 metallic_roughness: None,
                 transmission: None,
                 normal: None,
+                clearcoat: None,
+                clearcoat_roughness: None,
+                sheen_color: None,
+                sheen_roughness: None,
             },
             other_textures,
         ));
@@ -318,4 +435,11 @@ pub(super) struct MaterialImages {
     pub(super) transmission: Option<(usize, Sampling)>,
     /// The normal map and its scale.
     pub(super) normal: Option<((usize, Sampling), f32)>,
+    /// KHR_materials_clearcoat's clearcoatTexture (R multiplies the factor) and
+    /// clearcoatRoughnessTexture (G multiplies the roughness).
+    pub(super) clearcoat: Option<(usize, Sampling)>,
+    pub(super) clearcoat_roughness: Option<(usize, Sampling)>,
+    /// KHR_materials_sheen's sheenColorTexture (RGB, sRGB) and sheenRoughnessTexture (A).
+    pub(super) sheen_color: Option<(usize, Sampling)>,
+    pub(super) sheen_roughness: Option<(usize, Sampling)>,
 }

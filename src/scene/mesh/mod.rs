@@ -138,6 +138,12 @@ pub(super) struct FileTextures {
     normal: Option<((Rc<ImageSource>, Sampling), f32)>,
     /// OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, merged on load.
     roughness_and_metallic: Option<(Option<PathBuf>, Option<PathBuf>)>,
+    /// KHR_materials_clearcoat's clearcoatTexture (red) and clearcoatRoughnessTexture (green).
+    clearcoat: Option<(Rc<ImageSource>, Sampling)>,
+    clearcoat_roughness: Option<(Rc<ImageSource>, Sampling)>,
+    /// KHR_materials_sheen's sheenColorTexture (sRGB) and sheenRoughnessTexture (alpha).
+    sheen_color: Option<(Rc<ImageSource>, Sampling)>,
+    sheen_roughness: Option<(Rc<ImageSource>, Sampling)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -259,11 +265,20 @@ pub(crate) fn load(
                         m.emission_texture = load(&maps.emission, TextureUse::Color)?;
                         if let MaterialKind::Pbr {
                             transmission_texture,
+                            layers,
                             ..
                         } = &mut m.kind
                         {
                             *transmission_texture =
                                 load(&maps.transmission, TextureUse::Transmission)?;
+                            layers.clearcoat_texture =
+                                load(&maps.clearcoat, TextureUse::Transmission)?;
+                            layers.clearcoat_roughness_texture =
+                                load(&maps.clearcoat_roughness, TextureUse::MetallicRoughness)?;
+                            layers.sheen_color_texture =
+                                load(&maps.sheen_color, TextureUse::Color)?;
+                            layers.sheen_roughness_texture =
+                                load(&maps.sheen_roughness, TextureUse::SheenRoughness)?;
                         }
                         if let Some((map, scale)) = &maps.normal {
                             m.normal_texture =

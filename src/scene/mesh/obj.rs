@@ -135,6 +135,7 @@ fn obj_material(
             transmission_texture: None,
             attenuation_color: Vec3::ONE,
             attenuation_distance: None,
+            layers: Default::default(),
         }
     } else if m.dissolve.is_some_and(|d| d < 1.0) {
         MaterialKind::Dielectric {

@@ -4,7 +4,7 @@
 use super::super::file::{MaterialToml, Real, RoughnessToml, S};
 use super::super::limits::{MAX_IOR, MIN_IOR};
 use super::super::texture::{TextureSet, TextureUse};
-use super::super::{Alpha, AlphaMode, Material, MaterialKind};
+use super::super::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
 use super::fields::{fail, non_negative, radiance_in_range, real, vec3, FieldError};
 use glam::Vec3;
 use std::collections::BTreeMap;
@@ -176,6 +176,72 @@ pub(super) fn validate_materials(
                     }
                     None => None,
                 };
+                // A constant in [0, 1], or a texture whose first channel is the value.
+                let mut scalar = |x: &Option<S<RoughnessToml>>,
+                                  name: &str,
+                                  default: f32|
+                 -> Result<(f32, Option<u32>), FieldError> {
+                    match x.as_ref().map(|r| (r.span(), r.get_ref())) {
+                        Some((span, RoughnessToml::Value(v))) => {
+                            let v = real(&S::new(span.clone(), *v), &field(name))?;
+                            if !(0.0..=1.0).contains(&v) {
+                                return fail(span, field(name), format!("must be in [0, 1], got {v}"));
+                            }
+                            Ok((v, None))
+                        }
+                        Some((span, RoughnessToml::Other(value))) => Ok((
+                            1.0,
+                            Some(texture(
+                                &S::new(span, value.clone()),
+                                &field(name),
+                                folder,
+                                TextureUse::Roughness,
+                                &mut textures,
+                            )?),
+                        )),
+                        None => Ok((default, None)),
+                    }
+                };
+                let (clearcoat, clearcoat_texture) = scalar(&m.clearcoat, "clearcoat", 0.0)?;
+                let (clearcoat_roughness, clearcoat_roughness_texture) =
+                    scalar(&m.clearcoat_roughness, "clearcoat_roughness", 0.0)?;
+                let (sheen_roughness, sheen_roughness_texture) =
+                    scalar(&m.sheen_roughness, "sheen_roughness", 0.0)?;
+                let (sheen_color, sheen_color_texture) = match &m.sheen_color {
+                    Some(c) if c.get_ref().is_table() => (
+                        Vec3::ONE,
+                        Some(texture(
+                            c,
+                            &field("sheen_color"),
+                            folder,
+                            TextureUse::Color,
+                            &mut textures,
+                        )?),
+                    ),
+                    Some(c) => {
+                        let color = non_negative(c, &field("sheen_color"))?;
+                        if color.max_element() > 1.0 {
+                            return fail(
+                                c.span(),
+                                field("sheen_color"),
+                                format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
+                            );
+                        }
+                        (color, None)
+                    }
+                    None => (Vec3::ZERO, None),
+                };
+                let layers = PbrLayers {
+                    clearcoat,
+                    clearcoat_roughness,
+                    clearcoat_texture,
+                    clearcoat_roughness_texture,
+                    clearcoat_normal_texture: None,
+                    sheen_color,
+                    sheen_roughness,
+                    sheen_color_texture,
+                    sheen_roughness_texture,
+                };
                 MaterialKind::Pbr {
                     roughness,
                     metallic: unit(&m.metallic, "metallic", 0.0)?,
@@ -186,6 +252,7 @@ pub(super) fn validate_materials(
                     transmission_texture: None,
                     attenuation_color,
                     attenuation_distance,
+                    layers,
                 }
             }
             other => {
@@ -240,6 +307,18 @@ pub(super) fn validate_materials(
             (
                 m.attenuation_distance.as_ref().map(|r| r.span()),
                 "attenuation_distance",
+                pbr,
+            ),
+            (m.clearcoat.as_ref().map(|r| r.span()), "clearcoat", pbr),
+            (
+                m.clearcoat_roughness.as_ref().map(|r| r.span()),
+                "clearcoat_roughness",
+                pbr,
+            ),
+            (m.sheen_color.as_ref().map(|r| r.span()), "sheen_color", pbr),
+            (
+                m.sheen_roughness.as_ref().map(|r| r.span()),
+                "sheen_roughness",
                 pbr,
             ),
         ] {
