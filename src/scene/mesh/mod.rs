@@ -158,6 +158,30 @@ pub(crate) fn load(
     scene_materials: &mut Vec<Material>,
     textures: &mut TextureSet,
 ) -> Result<LoadedMesh, String> {
+    load_placed(
+        path,
+        shown,
+        &[transform.matrix()],
+        material,
+        smooth,
+        scene_materials,
+        textures,
+    )
+}
+
+/// [`load`] with the file placed once per matrix in `placements` (a `[[meshes]]` entry's
+/// `instances`): the file is read and checked once, and each placement adds its own copy of
+/// the triangles, placement after placement. Instances are flattened into world-space
+/// triangles like any mesh, so memory grows with the instances, not only the unique geometry.
+pub(crate) fn load_placed(
+    path: &Path,
+    shown: &str,
+    placements: &[Mat4],
+    material: Option<u32>,
+    smooth: bool,
+    scene_materials: &mut Vec<Material>,
+    textures: &mut TextureSet,
+) -> Result<LoadedMesh, String> {
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
@@ -198,14 +222,29 @@ pub(crate) fn load(
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let scene_matrix = transform.matrix();
+    // Checked before any copy is made: many placements of a large file would otherwise fill
+    // the memory before the count is seen.
+    let faces: usize = file.parts.iter().map(|p| p.geometry.indices.len()).sum();
+    let placed = faces.saturating_mul(placements.len());
+    if placements.len() > 1 && placed > MAX_TRIANGLES {
+        return Err(format!(
+            "{shown}: {faces} triangles placed {} times are {placed} triangles, more than the \
+             {MAX_TRIANGLES} glint holds (instances are copied into the scene's triangles)",
+            placements.len()
+        ));
+    }
     let mut triangles = Vec::new();
     let mut degenerate = 0usize;
     let mut checked = std::collections::HashSet::new();
     let mut tangent_cache: std::collections::HashMap<*const Geometry, Rc<Vec<[Vec4; 3]>>> =
         std::collections::HashMap::new();
-    for part in &file.parts {
-        let matrix = scene_matrix * part.transform;
+    // Placement after placement, each with every part in the file's order: one placement is
+    // exactly the mesh without instances.
+    for (scene_matrix, part) in placements
+        .iter()
+        .flat_map(|m| file.parts.iter().map(move |p| (m, p)))
+    {
+        let matrix = *scene_matrix * part.transform;
         // Normals go through the inverse transpose of the linear part.
         let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
         let geometry = &*part.geometry;
