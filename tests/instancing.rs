@@ -201,9 +201,10 @@ fn bad_instances_are_named_errors() {
     }
 }
 
-/// 10⁴ instances of a 2·10⁵-triangle mesh (2·10⁹ triangles) are more than a scene holds: the
-/// error says so, before any copy is made (the test would otherwise need hundreds of GiB).
-/// 10⁴ instances of a 36-triangle mesh load, every one placed.
+/// 10⁴ instances of a 2·10⁵-triangle mesh (2·10⁹ triangles), and 200 of it (4·10⁷), are more
+/// than one mesh's instances may place (2²⁵): the error says so, before any copy is made (the
+/// first would otherwise need hundreds of GiB). 10⁴ instances of a 36-triangle mesh load,
+/// every one placed.
 #[test]
 fn instance_counts_are_bounded_before_copying() {
     let dir = tempfile::tempdir().unwrap();
@@ -219,10 +220,13 @@ fn instance_counts_are_bounded_before_copying() {
     let big = StressMesh::new(400, 251);
     assert_eq!(big.indices.len(), 200_000);
     big.write_ply(&dir.path().join("big.ply")).unwrap();
-    let e = load(dir.path(), &many(10_000)).expect_err("2e9 triangles");
-    let message = e.to_string();
-    for needle in ["meshes[0].file", "placed 10000 times", "more than"] {
-        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    for count in [10_000, 200] {
+        let e = load(dir.path(), &many(count)).expect_err("too many triangles");
+        let message = e.to_string();
+        let placed = format!("placed {count} times");
+        for needle in ["meshes[0].file", &placed, "more than the 33554432"] {
+            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+        }
     }
     let small = StressMesh::new(6, 4);
     small.write_ply(&dir.path().join("big.ply")).unwrap();

@@ -31,6 +31,12 @@ use std::rc::Rc;
 /// fit any GPU's storage binding anyway.
 pub const MAX_TRIANGLES: usize = 1 << 28;
 
+/// The most triangles one `[[meshes]]` entry's instances may place in all: about what one
+/// mesh file within the 1 GiB file limit can hold (a binary PLY of a closed mesh, ~25 bytes a
+/// triangle). Instances are copies, so without this a small file placed many times could ask
+/// for far more memory than any mesh file could.
+pub const MAX_PLACED_TRIANGLES: usize = 1 << 25;
+
 /// Whether `path` names a glTF file (`.gltf`, `.glb`), by its extension.
 pub fn is_gltf(path: &Path) -> bool {
     path.extension()
@@ -226,10 +232,11 @@ pub(crate) fn load_placed(
     // the memory before the count is seen.
     let faces: usize = file.parts.iter().map(|p| p.geometry.indices.len()).sum();
     let placed = faces.saturating_mul(placements.len());
-    if placements.len() > 1 && placed > MAX_TRIANGLES {
+    if placements.len() > 1 && placed > MAX_PLACED_TRIANGLES {
         return Err(format!(
             "{shown}: {faces} triangles placed {} times are {placed} triangles, more than the \
-             {MAX_TRIANGLES} glint holds (instances are copied into the scene's triangles)",
+             {MAX_PLACED_TRIANGLES} one mesh's instances may place (instances are copied into \
+             the scene's triangles)",
             placements.len()
         ));
     }
