@@ -233,3 +233,136 @@ fn instance_counts_are_bounded_before_copying() {
     let scene = load(dir.path(), &many(10_000)).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(scene.triangles.len(), 10_000 * small.indices.len());
 }
+
+/// A glTF file of one triangle (accessor 0) with three instances' TRANSLATION (1), ROTATION (2)
+/// and SCALE (3) accessors, and a SCALE with one element too few (4); `nodes` is its node
+/// list (the scene places node 0).
+fn instancing_gltf(nodes: &str) -> String {
+    use base64::Engine as _;
+    let floats: [&[f32]; 4] = [
+        &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+        &[-1.0, 0.0, 0.0, 1.0, 0.5, 0.0, 0.0, -1.0, 0.25],
+        &[
+            0.0,
+            0.0,
+            0.0,
+            1.0,
+            0.0,
+            0.382_683_43,
+            0.0,
+            0.923_879_5,
+            0.5,
+            0.5,
+            0.5,
+            0.5,
+        ],
+        &[1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 1.0, 0.5, 3.0],
+    ];
+    let mut bytes = Vec::new();
+    let mut views = Vec::new();
+    for f in floats {
+        views.push(format!(
+            r#"{{"buffer": 0, "byteOffset": {}, "byteLength": {}}}"#,
+            bytes.len(),
+            4 * f.len()
+        ));
+        bytes.extend(f.iter().flat_map(|x| x.to_le_bytes()));
+    }
+    let accessor = |view: usize, kind: &str, count: usize| {
+        format!(
+            r#"{{"bufferView": {view}, "componentType": 5126, "count": {count}, "type": "{kind}"}}"#
+        )
+    };
+    let accessors = [
+        accessor(0, "VEC3", 3),
+        accessor(1, "VEC3", 3),
+        accessor(2, "VEC4", 3),
+        accessor(3, "VEC3", 3),
+        accessor(3, "VEC3", 2),
+    ]
+    .join(", ");
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+"buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{}"}}],
+"bufferViews": [{}], "accessors": [{accessors}],
+"meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+"nodes": [{nodes}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#,
+        bytes.len(),
+        base64::engine::general_purpose::STANDARD.encode(&bytes),
+        views.join(", ")
+    )
+}
+
+/// The instances' node: moved by its own translation, then the instances' T·R·S.
+const INSTANCED_NODE: &str = r#"{"mesh": 0, "translation": [0.0, 0.0, 5.0], "extensions":
+{"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 1, "ROTATION": 2, "SCALE": 3}}}}"#;
+
+/// `model.gltf` holding `gltf`, placed by a scene in `dir`.
+fn load_gltf(dir: &Path, gltf: &str) -> Result<Scene, SceneError> {
+    std::fs::write(dir.join("model.gltf"), gltf).unwrap();
+    load(
+        dir,
+        &format!("{MESH_SCENE_HEADER}\n[[meshes]]\nfile = \"model.gltf\"\nmaterial = \"white\"\n"),
+    )
+}
+
+/// EXT_mesh_gpu_instancing places the mesh once per instance, each at the node's transform
+/// times its T·R·S: the same triangles, bit for bit, as child nodes with those T·R·S under a
+/// node with the instanced node's translation.
+#[test]
+fn gltf_gpu_instancing_is_child_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let instanced =
+        load_gltf(dir.path(), &instancing_gltf(INSTANCED_NODE)).unwrap_or_else(|e| panic!("{e}"));
+    // Listed last first: the hierarchy's walk takes the last child first.
+    let children = r#"{"translation": [0.0, 0.0, 5.0], "children": [3, 2, 1]},
+{"mesh": 0, "translation": [-1.0, 0.0, 0.0]},
+{"mesh": 0, "translation": [1.0, 0.5, 0.0], "rotation": [0.0, 0.38268343, 0.0, 0.9238795], "scale": [2.0, 2.0, 2.0]},
+{"mesh": 0, "translation": [0.0, -1.0, 0.25], "rotation": [0.5, 0.5, 0.5, 0.5], "scale": [1.0, 0.5, 3.0]}"#;
+    let nodes = load_gltf(dir.path(), &instancing_gltf(children)).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(instanced.triangles.len(), 3);
+    assert_eq!(instanced.triangles, nodes.triangles);
+    // The second instance: scaled by 2, turned 45° about y, moved by (1, 0.5, 0) and (0, 0, 5).
+    let expected = Mat4::from_translation(Vec3::new(1.0, 0.5, 5.0))
+        * Mat4::from_rotation_y(45f32.to_radians())
+        * Mat4::from_scale(Vec3::splat(2.0));
+    let v = instanced.triangles[1].vertices[1];
+    assert!(
+        (v - expected.transform_point3(Vec3::X)).length() < 1e-5,
+        "{v}"
+    );
+}
+
+/// Bad EXT_mesh_gpu_instancing data is an error naming the node, the attribute and the fault.
+#[test]
+fn bad_gltf_gpu_instancing_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let field = "nodes[0].extensions.EXT_mesh_gpu_instancing.attributes";
+    let cases: [(&str, &[&str]); 5] = [
+        (
+            r#"{"TRANSLATION": 1, "SCALE": 4}"#,
+            &["SCALE", "holds 2", "holds 3"],
+        ),
+        (
+            r#"{"TRANSLATION": 2}"#,
+            &["TRANSLATION: accessors[2]", "VEC4"],
+        ),
+        (
+            r#"{"TRANSLATION": 9}"#,
+            &["TRANSLATION: accessor 9 does not exist"],
+        ),
+        (r#"{"SHEAR": 1}"#, &["SHEAR: not an attribute"]),
+        (r#"{"_ID": 1}"#, &["names none of"]),
+    ];
+    for (attributes, needles) in cases {
+        let node = format!(
+            r#"{{"mesh": 0, "extensions": {{"EXT_mesh_gpu_instancing": {{"attributes": {attributes}}}}}}}"#
+        );
+        let e = load_gltf(dir.path(), &instancing_gltf(&node)).expect_err(attributes);
+        let message = e.to_string();
+        assert!(message.contains(field), "{message}");
+        for needle in needles {
+            assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+        }
+    }
+}

@@ -4,11 +4,13 @@
 //! that are not finite, indices out of range, meshes left with no triangles.
 //!
 //! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`; a glTF file's node hierarchy, cameras
-//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`); this file holds what they share: the
+//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`;
+//! `EXT_mesh_gpu_instancing` in `gltf_instancing.rs`); this file holds what they share: the
 //! parts a file yields, the material checks, and turning parts into scene triangles.
 
 mod gltf;
 mod gltf_cameras;
+mod gltf_instancing;
 mod gltf_lights;
 mod gltf_material;
 mod gltf_nodes;
