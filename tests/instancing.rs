@@ -366,3 +366,32 @@ fn bad_gltf_gpu_instancing_is_named() {
         }
     }
 }
+
+/// A glTF file's punctual lights are placed with every instance: tests/models'
+/// lights-cameras.gltf (3 lights, its point light at (1, 3, 1)) placed twice has 6, the
+/// second instance's point light moved with it.
+#[test]
+fn gltf_lights_are_placed_with_every_instance() {
+    use glint::scene::light::LightKind;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models/lights-cameras.gltf"),
+        dir.path().join("model.gltf"),
+    )
+    .unwrap();
+    let scene = load(
+        dir.path(),
+        &format!(
+            "{MESH_SCENE_HEADER}\n[[meshes]]\nfile = \"model.gltf\"\nmaterial = \"white\"\n\
+             instances = [{{}}, {{ translate = [0.0, 0.0, 2.0] }}]\n"
+        ),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.lights.len(), 6);
+    for (light, z) in [(&scene.lights[0], 1.0), (&scene.lights[3], 3.0)] {
+        assert!(
+            matches!(light.kind, LightKind::Point { position, .. } if position == Vec3::new(1.0, 3.0, z)),
+            "{light:?}"
+        );
+    }
+}

@@ -168,11 +168,15 @@ pub(super) fn validate_objects(
                     mesh::gltf_lights(&folder.join(file), *placement).or_else(|message| {
                         fail(m.file.span(), field("file"), format!("{file}: {message}"))
                     })?;
-                lights.append(&mut file_lights);
-                // The same warnings for every placement: said once.
+                // The same warnings for every placement: said once. A file without lights
+                // is not read again for every instance.
                 if p == 0 {
                     warnings.extend(file_warnings.into_iter().map(|w| format!("{file}: {w}")));
+                    if file_lights.is_empty() {
+                        break;
+                    }
                 }
+                lights.append(&mut file_lights);
             }
         }
         if triangles.len() > mesh::MAX_TRIANGLES {
