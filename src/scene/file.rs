@@ -166,6 +166,10 @@ pub(super) struct MeshToml {
     pub(super) smooth: Option<bool>,
     /// Whether the file's punctual lights (glTF `KHR_lights_punctual`) join the scene.
     pub(super) lights: Option<bool>,
+    /// Where the mesh is placed, each a table with optional `translate`, `rotate` and `scale`
+    /// applied after the mesh's own: any TOML value here, checked in [`super::validate`] where
+    /// each instance's index is known for the message.
+    pub(super) instances: Option<S<Vec<S<toml::Value>>>>,
 }
 
 /// `scale = 2.0` or `scale = [1.0, 2.0, 1.0]`.

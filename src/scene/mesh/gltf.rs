@@ -12,11 +12,12 @@
 //! node is visited once; and the triangles the nodes place and the data decoded stay within
 //! bounds set by the file's real size. Each error names the element (`accessors[3]`).
 
+use super::gltf_instancing::{self, Attributes};
 use super::gltf_material::material;
 use super::gltf_nodes::placed_nodes;
 use super::{
     one_line, read_mesh_bytes, FileTextures, Geometry, ImageSource, MeshFile, MeshPart,
-    MAX_TRIANGLES,
+    MAX_PLACED_TRIANGLES, MAX_TRIANGLES,
 };
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::texture::Sampling;
@@ -32,6 +33,7 @@ use std::rc::Rc;
 
 /// Extensions a file may require: glint reads them (the material ones in part, see README.md).
 const REQUIRABLE_EXTENSIONS: &[&str] = &[
+    "EXT_mesh_gpu_instancing",
     "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
@@ -48,6 +50,7 @@ const REQUIRABLE_EXTENSIONS: &[&str] = &[
 /// (KHR_materials_volume's thicknessFactor and thicknessTexture are for rasterisers, which
 /// cannot trace the ray through the mesh: glint does, and ignores them.)
 const FULLY_READ_EXTENSIONS: &[&str] = &[
+    "EXT_mesh_gpu_instancing",
     "KHR_lights_punctual",
     "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
@@ -133,14 +136,33 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     // Every primitive the scene places is checked before any is read, and the triangles
     // counted: a small file must not make the instances' triangles exceed glint's limit. A
     // primitive counts as one triangle at least, which bounds the parts made too.
+    // EXT_mesh_gpu_instancing's copies are bounded as a scene's `instances` are
+    // (MAX_PLACED_TRIANGLES): a few bytes of accessor place a whole mesh again.
     let mut plans: HashMap<usize, Vec<PrimitivePlan>> = HashMap::new();
     let mut triangles = 0u64;
+    let mut gpu_instanced = 0u64;
     for instance in &instances {
         let plan = match plans.entry(instance.mesh) {
             Entry::Occupied(plan) => plan.into_mut(),
             Entry::Vacant(slot) => slot.insert(mesh_plan(&root, &buffers, instance.mesh)?),
         };
-        triangles += plan.iter().map(|p| p.triangles.max(1)).sum::<u64>();
+        let copies = instance
+            .gpu_instances
+            .as_ref()
+            .map_or(1, |a| a.count as u64);
+        let placed = plan.iter().map(|p| p.triangles.max(1)).sum::<u64>() * copies;
+        triangles += placed;
+        if instance.gpu_instances.is_some() {
+            gpu_instanced += placed;
+            if gpu_instanced > MAX_PLACED_TRIANGLES as u64 {
+                return Err(format!(
+                    "nodes[{}].extensions.{}: the file's instances place more than \
+                     {MAX_PLACED_TRIANGLES} triangles, the most glint copies for instances",
+                    instance.node,
+                    gltf_instancing::EXTENSION
+                ));
+            }
+        }
         if triangles > MAX_TRIANGLES as u64 {
             return Err(format!(
                 "nodes[{}]: the scene's nodes place more than {MAX_TRIANGLES} triangles, glint's limit",
@@ -157,7 +179,21 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
     let mut geometries: HashMap<(usize, usize), Rc<Geometry>> = HashMap::new();
     let mut parts = Vec::new();
     for instance in &instances {
-        for (p, plan) in plans[&instance.mesh].iter().enumerate() {
+        let placements = match &instance.gpu_instances {
+            Some(attributes) => {
+                gltf_instancing::transforms(attributes, instance.node, &mut decoder)?
+                    .into_iter()
+                    .map(|m| instance.transform * m)
+                    .collect()
+            }
+            None => vec![instance.transform],
+        };
+        for (transform, (p, plan)) in placements.iter().flat_map(|t| {
+            plans[&instance.mesh]
+                .iter()
+                .enumerate()
+                .map(move |plan| (t, plan))
+        }) {
             let key = (instance.mesh, p);
             let geometry = match geometries.get(&key) {
                 Some(g) => g.clone(),
@@ -169,7 +205,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
             };
             parts.push(MeshPart {
                 geometry,
-                transform: instance.transform,
+                transform: *transform,
                 material: plan.material,
                 name: format!("meshes[{}].primitives[{p}]", instance.mesh),
             });
@@ -382,6 +418,8 @@ struct Instance {
     node: usize,
     mesh: usize,
     transform: Mat4,
+    /// The node's EXT_mesh_gpu_instancing instances, each placing the mesh again.
+    gpu_instances: Option<Attributes>,
 }
 
 /// The meshes the scene's nodes place, with each node's world transform
@@ -393,16 +431,18 @@ fn instances(root: &json::Root) -> Result<Vec<Instance>, String> {
                 .map_err(|e| format!("nodes[{i}].mesh: {e}"))?;
         }
     }
-    Ok(placed_nodes(root)?
-        .into_iter()
-        .filter_map(|placed| {
-            root.nodes[placed.node].mesh.map(|mesh| Instance {
+    let mut out = Vec::new();
+    for placed in placed_nodes(root)? {
+        if let Some(mesh) = root.nodes[placed.node].mesh {
+            out.push(Instance {
                 node: placed.node,
                 mesh: mesh.value(),
                 transform: placed.transform,
-            })
-        })
-        .collect())
+                gpu_instances: gltf_instancing::attributes(root, placed.node)?,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Where image `i` comes from: a file its URI names, or bytes in the glTF file (a buffer view
@@ -531,7 +571,7 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
 }
 
 /// Where an accessor's elements lie, checked against its buffer views.
-struct Layout<'a> {
+pub(super) struct Layout<'a> {
     index: usize,
     count: usize,
     component: ComponentType,
@@ -793,7 +833,7 @@ impl<'a> Layout<'a> {
     }
 
     /// Every element's components as f32, normalized integers mapped to [0, 1] or [-1, 1].
-    fn floats<const N: usize>(&self) -> Result<Vec<[f32; N]>, String> {
+    pub(super) fn floats<const N: usize>(&self) -> Result<Vec<[f32; N]>, String> {
         debug_assert_eq!(N, self.components);
         let component = |bytes: &[u8], c: usize| -> f32 {
             let size = component_size(self.component);
@@ -854,14 +894,19 @@ fn float(bytes: &[u8], c: ComponentType, normalized: bool) -> f32 {
 
 /// Reads primitives' accessors, keeping the decoded bytes within a budget set by the size of
 /// the file's buffers.
-struct Decoder<'a> {
+pub(super) struct Decoder<'a> {
     root: &'a json::Root,
     buffers: &'a Buffers,
     budget: u64,
 }
 
 impl Decoder<'_> {
-    fn layout(&mut self, a: usize, kind: Type, is_index: bool) -> Result<Layout<'_>, String> {
+    pub(super) fn layout(
+        &mut self,
+        a: usize,
+        kind: Type,
+        is_index: bool,
+    ) -> Result<Layout<'_>, String> {
         let layout = Layout::of(self.root, self.buffers, a, kind, is_index)?;
         let bytes = layout.count as u64 * layout.components as u64 * 4;
         if bytes > self.budget {

@@ -4,11 +4,13 @@
 //! that are not finite, indices out of range, meshes left with no triangles.
 //!
 //! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`; a glTF file's node hierarchy, cameras
-//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`); this file holds what they share: the
+//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`;
+//! `EXT_mesh_gpu_instancing` in `gltf_instancing.rs`); this file holds what they share: the
 //! parts a file yields, the material checks, and turning parts into scene triangles.
 
 mod gltf;
 mod gltf_cameras;
+mod gltf_instancing;
 mod gltf_lights;
 mod gltf_material;
 mod gltf_nodes;
@@ -30,6 +32,12 @@ use std::rc::Rc;
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
 /// fit any GPU's storage binding anyway.
 pub const MAX_TRIANGLES: usize = 1 << 28;
+
+/// The most triangles one `[[meshes]]` entry's instances may place in all: about what one
+/// mesh file within the 1 GiB file limit can hold (a binary PLY of a closed mesh, ~25 bytes a
+/// triangle). Instances are copies, so without this a small file placed many times could ask
+/// for far more memory than any mesh file could.
+pub const MAX_PLACED_TRIANGLES: usize = 1 << 25;
 
 /// Whether `path` names a glTF file (`.gltf`, `.glb`), by its extension.
 pub fn is_gltf(path: &Path) -> bool {
@@ -164,6 +172,30 @@ pub(crate) fn load(
     scene_materials: &mut Vec<Material>,
     textures: &mut TextureSet,
 ) -> Result<LoadedMesh, String> {
+    load_placed(
+        path,
+        shown,
+        &[transform.matrix()],
+        material,
+        smooth,
+        scene_materials,
+        textures,
+    )
+}
+
+/// [`load`] with the file placed once per matrix in `placements` (a `[[meshes]]` entry's
+/// `instances`): the file is read and checked once, and each placement adds its own copy of
+/// the triangles, placement after placement. Instances are flattened into world-space
+/// triangles like any mesh, so memory grows with the instances, not only the unique geometry.
+pub(crate) fn load_placed(
+    path: &Path,
+    shown: &str,
+    placements: &[Mat4],
+    material: Option<u32>,
+    smooth: bool,
+    scene_materials: &mut Vec<Material>,
+    textures: &mut TextureSet,
+) -> Result<LoadedMesh, String> {
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
@@ -204,14 +236,30 @@ pub(crate) fn load(
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let scene_matrix = transform.matrix();
+    // Checked before any copy is made: many placements of a large file would otherwise fill
+    // the memory before the count is seen.
+    let faces: usize = file.parts.iter().map(|p| p.geometry.indices.len()).sum();
+    let placed = faces.saturating_mul(placements.len());
+    if placements.len() > 1 && placed > MAX_PLACED_TRIANGLES {
+        return Err(format!(
+            "{shown}: {faces} triangles placed {} times are {placed} triangles, more than the \
+             {MAX_PLACED_TRIANGLES} one mesh's instances may place (instances are copied into \
+             the scene's triangles)",
+            placements.len()
+        ));
+    }
     let mut triangles = Vec::new();
     let mut degenerate = 0usize;
     let mut checked = std::collections::HashSet::new();
     let mut tangent_cache: std::collections::HashMap<*const Geometry, Rc<Vec<[Vec4; 3]>>> =
         std::collections::HashMap::new();
-    for part in &file.parts {
-        let matrix = scene_matrix * part.transform;
+    // Placement after placement, each with every part in the file's order: one placement is
+    // exactly the mesh without instances.
+    for (scene_matrix, part) in placements
+        .iter()
+        .flat_map(|m| file.parts.iter().map(move |p| (m, p)))
+    {
+        let matrix = *scene_matrix * part.transform;
         // Normals go through the inverse transpose of the linear part.
         let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
         let geometry = &*part.geometry;

@@ -7,7 +7,8 @@ use super::super::mesh::{self, MeshTransform};
 use super::super::{AlphaMode, Material, Quad, Sphere, Triangle};
 use super::fields::{coordinates, fail, length_in_range, real, sine_between, vec3, FieldError};
 use super::materials::Materials;
-use glam::Vec3;
+use glam::{Mat4, Vec3};
+use std::ops::Range;
 use std::path::Path;
 
 /// The scene's geometry, and warnings to print (from mesh files).
@@ -128,14 +129,7 @@ pub(super) fn validate_objects(
                     ScaleToml::Uniform(r) => Vec3::splat(r.0 as f32),
                     ScaleToml::PerAxis(a) => Vec3::new(a[0].0 as f32, a[1].0 as f32, a[2].0 as f32),
                 };
-                if !v.is_finite() || v.min_element() <= 0.0 {
-                    return fail(
-                        s.span(),
-                        field("scale"),
-                        format!("degenerate transform: every scale factor must be finite and > 0, got {v}"),
-                    );
-                }
-                v
+                positive_scale(v, s.span(), &field("scale"))?
             }
         };
         let material = match &m.material {
@@ -148,10 +142,18 @@ pub(super) fn validate_objects(
             rotate_degrees: rotate,
             translate,
         };
-        let loaded = mesh::load(
+        // The mesh's own transform first, then each instance's.
+        let placements: Vec<Mat4> = match &m.instances {
+            None => vec![transform.matrix()],
+            Some(list) => instances(list, &field("instances"))?
+                .iter()
+                .map(|instance| instance.matrix() * transform.matrix())
+                .collect(),
+        };
+        let loaded = mesh::load_placed(
             &folder.join(file),
             file,
-            &transform,
+            &placements,
             material,
             m.smooth.unwrap_or(true),
             &mut materials.list,
@@ -161,12 +163,21 @@ pub(super) fn validate_objects(
         warnings.extend(loaded.warnings);
         triangles.extend(loaded.triangles);
         if m.lights.unwrap_or(true) && mesh::is_gltf(Path::new(file)) {
-            let (mut file_lights, file_warnings) =
-                mesh::gltf_lights(&folder.join(file), transform.matrix()).or_else(|message| {
-                    fail(m.file.span(), field("file"), format!("{file}: {message}"))
-                })?;
-            lights.append(&mut file_lights);
-            warnings.extend(file_warnings.into_iter().map(|w| format!("{file}: {w}")));
+            for (p, placement) in placements.iter().enumerate() {
+                let (mut file_lights, file_warnings) =
+                    mesh::gltf_lights(&folder.join(file), *placement).or_else(|message| {
+                        fail(m.file.span(), field("file"), format!("{file}: {message}"))
+                    })?;
+                // The same warnings for every placement: said once. A file without lights
+                // is not read again for every instance.
+                if p == 0 {
+                    warnings.extend(file_warnings.into_iter().map(|w| format!("{file}: {w}")));
+                    if file_lights.is_empty() {
+                        break;
+                    }
+                }
+                lights.append(&mut file_lights);
+            }
         }
         if triangles.len() > mesh::MAX_TRIANGLES {
             return fail(
@@ -186,4 +197,74 @@ pub(super) fn validate_objects(
         lights,
         warnings,
     })
+}
+
+/// A scale factor per axis, each finite and > 0 (a mesh's `scale` or an instance's).
+fn positive_scale(v: Vec3, span: Range<usize>, field: &str) -> Result<Vec3, FieldError> {
+    if !v.is_finite() || v.min_element() <= 0.0 {
+        return fail(
+            span,
+            field,
+            format!("degenerate transform: every scale factor must be finite and > 0, got {v}"),
+        );
+    }
+    Ok(v)
+}
+
+/// A `[[meshes]]` entry's `instances` (named `field`): at least one, each a table of the
+/// mesh's own optional `translate`, `rotate` and `scale`, with the same meanings and checks.
+/// Errors name the instance and its key, at the instance's place in the file.
+fn instances(list: &S<Vec<S<toml::Value>>>, field: &str) -> Result<Vec<MeshTransform>, FieldError> {
+    if list.get_ref().is_empty() {
+        return fail(
+            list.span(),
+            field,
+            "must place the mesh at least once (leave `instances` out to place it as it is)",
+        );
+    }
+    let mut out = Vec::with_capacity(list.get_ref().len());
+    for (j, entry) in list.get_ref().iter().enumerate() {
+        let at = |key: &str| format!("{field}[{j}]{key}");
+        let toml::Value::Table(table) = entry.get_ref() else {
+            return fail(
+                entry.span(),
+                at(""),
+                format!(
+                    "must be a table like {{ translate = [x, y, z], rotate = [x, y, z], scale = s }}, got a {}",
+                    entry.get_ref().type_str()
+                ),
+            );
+        };
+        let mut instance = MeshTransform {
+            scale: Vec3::ONE,
+            rotate_degrees: Vec3::ZERO,
+            translate: Vec3::ZERO,
+        };
+        for (key, value) in table {
+            let name = at(&format!(".{key}"));
+            // The values inside a table carry no place of their own: the instance's is used.
+            let value = S::new(entry.span(), value.clone());
+            match key.as_str() {
+                "translate" => instance.translate = coordinates(&value, &name)?,
+                "rotate" => instance.rotate_degrees = vec3(&value, &name)?,
+                "scale" => {
+                    let v = match value.get_ref() {
+                        toml::Value::Float(r) => Vec3::splat(*r as f32),
+                        toml::Value::Integer(r) => Vec3::splat(*r as f32),
+                        _ => vec3(&value, &name)?,
+                    };
+                    instance.scale = positive_scale(v, entry.span(), &name)?;
+                }
+                _ => {
+                    return fail(
+                        entry.span(),
+                        name,
+                        "unknown key: an instance takes `translate`, `rotate` and `scale`",
+                    )
+                }
+            }
+        }
+        out.push(instance);
+    }
+    Ok(out)
 }
