@@ -222,6 +222,14 @@ struct TriangleUvs {
     uv2: vec2<f32>,
 }
 
+// A triangle's vertex colours (glTF's COLOR_0, linear RGBA; white where the mesh has none),
+// multiplying the base colour and its alpha.
+struct TriangleColors {
+    c0: vec4<f32>,
+    c1: vec4<f32>,
+    c2: vec4<f32>,
+}
+
 // The emitter table's entry for the environment map (index 0).
 const PRIMITIVE_ENVIRONMENT: u32 = 3u;
 

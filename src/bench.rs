@@ -117,6 +117,7 @@ fn add_stress_mesh(scene: &mut Scene, triangles: u32) {
             material,
             uvs: None,
             tangents: None,
+            colors: None,
         });
     }
 }

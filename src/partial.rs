@@ -79,6 +79,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         texels,
         triangle_uvs,
         triangle_tangents,
+        triangle_colors,
         environment_texels,
         environment_alias,
         lights,
@@ -105,6 +106,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     array("texels", bytemuck::cast_slice(texels));
     array("triangle uvs", bytemuck::cast_slice(triangle_uvs));
     array("triangle tangents", bytemuck::cast_slice(triangle_tangents));
+    array("triangle colors", bytemuck::cast_slice(triangle_colors));
     array(
         "environment texels",
         bytemuck::cast_slice(environment_texels),

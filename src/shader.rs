@@ -10,7 +10,7 @@ use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 29] = [
+pub const SHADER_PARTS: [(&str, &str); 30] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -45,6 +45,10 @@ pub const SHADER_PARTS: [(&str, &str); 29] = [
     ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
+    (
+        "vertex_color.wgsl",
+        include_str!("../shaders/vertex_color.wgsl"),
+    ),
     ("alpha.wgsl", include_str!("../shaders/alpha.wgsl")),
     (
         "normal_map.wgsl",
@@ -283,6 +287,8 @@ pub struct KernelFeatures {
     /// Alpha-tested or blended materials (shaders/alpha.wgsl): without them every triangle hit
     /// is accepted as before, at the same cost.
     pub alpha: bool,
+    /// Meshes with vertex colours (glTF's COLOR_0, shaders/vertex_color.wgsl).
+    pub vertex_colors: bool,
 }
 
 impl KernelFeatures {
@@ -303,6 +309,7 @@ impl KernelFeatures {
         lights: true,
         sun_disks: true,
         alpha: true,
+        vertex_colors: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -332,6 +339,7 @@ impl KernelFeatures {
                 .iter()
                 .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
             alpha: has_alpha(&scene.materials),
+            vertex_colors: !scene.triangle_colors.is_empty(),
         }
     }
 
@@ -353,6 +361,7 @@ impl KernelFeatures {
             && needs(self.lights, other.lights)
             && needs(self.sun_disks, other.sun_disks)
             && needs(self.alpha, other.alpha)
+            && needs(self.vertex_colors, other.vertex_colors)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -365,7 +374,7 @@ impl KernelFeatures {
              const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
-             const HAS_ALPHA: bool = {};\n",
+             const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -380,7 +389,8 @@ impl KernelFeatures {
             self.environment,
             self.lights,
             self.sun_disks,
-            self.alpha
+            self.alpha,
+            self.vertex_colors
         )
     }
 }

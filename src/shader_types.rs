@@ -288,6 +288,16 @@ pub struct TriangleUvs {
     pub uv2: [f32; 2],
 }
 
+/// A triangle's vertex colours (glTF's COLOR_0, linear RGBA; white where the mesh has none),
+/// multiplying the base colour and its alpha. One per triangle when a mesh has them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TriangleColors {
+    pub c0: [f32; 4],
+    pub c1: [f32; 4],
+    pub c2: [f32; 4],
+}
+
 /// The emitter table's entry for the environment map (`index` 0).
 pub const PRIMITIVE_ENVIRONMENT: u32 = 3;
 

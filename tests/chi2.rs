@@ -306,6 +306,7 @@ emission = [1.0, 1.0, 1.0]
             material: if k % 2 == 0 { bright } else { dim },
             uvs: None,
             tangents: None,
+            colors: None,
         });
     }
     scene

@@ -288,6 +288,11 @@ impl<'a> GpuRenderer<'a> {
                     read_only,
                 ),
                 BufferNeed::new(
+                    "triangle vertex colours",
+                    array_bytes(&scene.triangle_colors),
+                    read_only,
+                ),
+                BufferNeed::new(
                     "environment map",
                     array_bytes(&scene.environment_texels),
                     read_only,
@@ -351,6 +356,8 @@ impl<'a> GpuRenderer<'a> {
         };
         let triangle_uvs = storage_buffer(ctx, "triangle texture coordinates", &scene.triangle_uvs);
         let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
+        let triangle_colors =
+            storage_buffer(ctx, "triangle vertex colours", &scene.triangle_colors);
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
@@ -435,6 +442,7 @@ impl<'a> GpuRenderer<'a> {
             (21, read_only, &texels[0]),
             (22, read_only, &triangle_uvs),
             (28, read_only, &triangle_tangents),
+            (34, read_only, &triangle_colors),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
             (24, read_only, &lights),

@@ -99,6 +99,8 @@ pub struct Triangle {
     pub uvs: Option<[Vec2; 3]>,
     /// Vertex tangents (xyz unit, w the bitangent's sign) where the material has a normal map.
     pub tangents: Option<[Vec4; 3]>,
+    /// Vertex colours (linear RGBA, glTF's COLOR_0), where the file gives them.
+    pub colors: Option<[Vec4; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

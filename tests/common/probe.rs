@@ -129,6 +129,7 @@ fn run_probe_with(
     let texels = storage_buffer(ctx, "texels", &scene.texels);
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
     let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
+    let triangle_colors = storage_buffer(ctx, "triangle colours", &scene.triangle_colors);
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let lights = storage_buffer(ctx, "lights", &scene.lights);
@@ -173,6 +174,7 @@ fn run_probe_with(
             (21, read_only, &texels),
             (22, read_only, &triangle_uvs),
             (28, read_only, &triangle_tangents),
+            (34, read_only, &triangle_colors),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
             (24, read_only, &lights),

@@ -70,6 +70,8 @@ pub(super) struct Geometry {
     /// glTF's TANGENT (xyz along increasing u, w the bitangent's sign), as many as positions,
     /// or none.
     tangents: Vec<Vec4>,
+    /// Vertex colours (linear RGBA in [0, 1], glTF's COLOR_0), as many as positions, or none.
+    colors: Vec<Vec4>,
     indices: Vec<[u32; 3]>,
 }
 
@@ -340,6 +342,8 @@ pub(crate) fn load(
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
             let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+            let colors =
+                (geometry.colors.len() == count).then(|| idx.map(|i| geometry.colors[i as usize]));
             let tangents = corners
                 .as_ref()
                 .and_then(|c| c.get(f))
@@ -350,6 +354,7 @@ pub(crate) fn load(
                 material,
                 uvs,
                 tangents,
+                colors,
             });
             if triangles.len() > MAX_TRIANGLES {
                 return Err(format!(

@@ -316,6 +316,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
                         .map(Vec2::from_slice)
                         .collect(),
                     tangents: Vec::new(),
+                    colors: Vec::new(),
                     indices: mesh
                         .indices
                         .chunks_exact(3)

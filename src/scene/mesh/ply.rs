@@ -93,6 +93,7 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
                 normals,
                 uvs: Vec::new(),
                 tangents: Vec::new(),
+                colors: Vec::new(),
                 indices,
             },
             None,
