@@ -212,6 +212,8 @@ struct Texture {
     // The texture coordinates the lookup uses: (dot(transform_u, (u, v, 1)),
     // dot(transform_v, (u, v, 1))) (glTF's KHR_texture_transform; the identity otherwise).
     transform_u: vec3<f32>,
+    // The texture coordinate set the lookup reads: 0, or 1 (glTF's TEXCOORD_1).
+    uv_set: u32,
     transform_v: vec3<f32>,
 }
 

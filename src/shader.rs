@@ -289,6 +289,8 @@ pub struct KernelFeatures {
     pub alpha: bool,
     /// Meshes with vertex colours (glTF's COLOR_0, shaders/vertex_color.wgsl).
     pub vertex_colors: bool,
+    /// Textures on the second texture coordinate set (glTF's TEXCOORD_1, shaders/texture.wgsl).
+    pub texcoord1: bool,
 }
 
 impl KernelFeatures {
@@ -310,6 +312,7 @@ impl KernelFeatures {
         sun_disks: true,
         alpha: true,
         vertex_colors: true,
+        texcoord1: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -340,6 +343,7 @@ impl KernelFeatures {
                 .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
             alpha: has_alpha(&scene.materials),
             vertex_colors: !scene.triangle_colors.is_empty(),
+            texcoord1: !scene.triangle_uvs1.is_empty(),
         }
     }
 
@@ -362,6 +366,7 @@ impl KernelFeatures {
             && needs(self.sun_disks, other.sun_disks)
             && needs(self.alpha, other.alpha)
             && needs(self.vertex_colors, other.vertex_colors)
+            && needs(self.texcoord1, other.texcoord1)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -374,7 +379,8 @@ impl KernelFeatures {
              const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
-             const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n",
+             const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
+             const HAS_TEXCOORD_1: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -390,7 +396,8 @@ impl KernelFeatures {
             self.lights,
             self.sun_disks,
             self.alpha,
-            self.vertex_colors
+            self.vertex_colors,
+            self.textures && self.texcoord1
         )
     }
 }

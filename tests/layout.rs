@@ -226,6 +226,7 @@ fn rust_structs_match_wgsl_layout() {
             color1,
             sampling,
             transform_u,
+            uv_set,
             transform_v
         ]
     );
@@ -381,6 +382,8 @@ fn every_feature_combination_validates() {
             alpha: (bits * 5 / 3) % 2 == 1,
             // Likewise, with and without alpha and textures.
             vertex_colors: (bits * 11 / 7) % 2 == 1,
+            // Likewise, with and without textures.
+            texcoord1: (bits * 13 / 9) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -420,6 +423,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         sun_disks: false,
         alpha: false,
         vertex_colors: false,
+        texcoord1: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

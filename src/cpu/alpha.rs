@@ -29,6 +29,8 @@ pub struct AlphaTest<'a> {
     pub materials: &'a [Material],
     pub textures: Textures<'a>,
     pub triangle_uvs: &'a [TriangleUvs],
+    /// The second set, where a texture reads it (else empty).
+    pub triangle_uvs1: &'a [TriangleUvs],
     /// One per triangle when a mesh has vertex colours (the kernel's `HAS_VERTEX_COLORS`),
     /// else empty.
     pub triangle_colors: &'a [TriangleColors],
@@ -62,7 +64,7 @@ pub fn alpha_skips(alpha: &AlphaTest, index: u32, tri: &Triangle, r: &TriangleRa
         // the colour texture and the vertex colours show them.
         let b = triangle_barycentrics(tri, r);
         if m.color_texture != NO_TEXTURE {
-            let uv = triangle_uv(&alpha.triangle_uvs[index as usize], b);
+            let uv = triangle_uv(alpha.triangle_uvs, alpha.triangle_uvs1, index, b);
             a *= texture_alpha(&alpha.textures, m.color_texture, uv);
         }
         if let Some(colors) = alpha.triangle_colors.get(index as usize) {

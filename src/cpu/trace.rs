@@ -44,6 +44,9 @@ pub struct SceneRefs<'a> {
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
     pub triangle_uvs: &'a [TriangleUvs],
+    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
+    /// empty.
+    pub triangle_uvs1: &'a [TriangleUvs],
     /// One per triangle when a material has a normal map, else empty.
     pub triangle_tangents: &'a [TriangleTangents],
     /// One per triangle when a mesh has vertex colours, else empty.
@@ -78,6 +81,7 @@ impl<'a> SceneRefs<'a> {
             textures: &scene.textures,
             texels: &scene.texels,
             triangle_uvs: &scene.triangle_uvs,
+            triangle_uvs1: &scene.triangle_uvs1,
             triangle_tangents: &scene.triangle_tangents,
             triangle_colors: &scene.triangle_colors,
             lights: &scene.lights,
@@ -112,12 +116,14 @@ impl<'a> SceneRefs<'a> {
             bvh_nodes: self.bvh_nodes,
             bvh_primitives: self.bvh_primitives,
             triangle_uvs: self.triangle_uvs,
+            triangle_uvs1: self.triangle_uvs1,
             textured: !self.textures.is_empty(),
             alpha: AlphaTest {
                 enabled: self.has_alpha,
                 materials: self.materials,
                 textures: self.textures(),
                 triangle_uvs: self.triangle_uvs,
+                triangle_uvs1: self.triangle_uvs1,
                 triangle_colors: self.triangle_colors,
                 key: self.alpha_key,
             },

@@ -37,6 +37,9 @@ pub struct KernelScene {
     pub texels: Vec<[f32; 4]>,
     /// One per triangle when the scene has textures, else empty.
     pub triangle_uvs: Vec<TriangleUvs>,
+    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
+    /// empty.
+    pub triangle_uvs1: Vec<TriangleUvs>,
     /// One per triangle when a material has a normal map, else empty.
     pub triangle_tangents: Vec<TriangleTangents>,
     /// One per triangle when a mesh has vertex colours, else empty.
@@ -66,6 +69,7 @@ impl KernelScene {
             + bytes(&self.textures)
             + bytes(&self.texels)
             + bytes(&self.triangle_uvs)
+            + bytes(&self.triangle_uvs1)
             + bytes(&self.triangle_tangents)
             + bytes(&self.triangle_colors)
             + bytes(&self.environment_texels)
@@ -343,6 +347,17 @@ impl Scene {
                         TriangleUvs { uv0, uv1, uv2 }
                     })
                     .collect()
+            },
+            triangle_uvs1: if self.textures.descriptors.iter().any(|t| t.uv_set == 1) {
+                self.triangles
+                    .iter()
+                    .map(|t| {
+                        let [uv0, uv1, uv2] = t.uvs1.unwrap_or_default().map(|uv| uv.into());
+                        TriangleUvs { uv0, uv1, uv2 }
+                    })
+                    .collect()
+            } else {
+                Vec::new()
             },
             triangle_tangents: if self.materials.iter().any(|m| m.normal_texture.is_some()) {
                 self.triangles

@@ -15,13 +15,15 @@ use std::path::{Path, PathBuf};
 pub const MAX_TOTAL_TEXELS: u64 = u32::MAX as u64;
 
 /// How a glTF texture reference reads its image: its sampler's wrap modes (`TEXTURE_WRAP_*`,
-/// for u and v) and filter, and KHR_texture_transform's affine map of (u, v, 1), in glint's
-/// texture coordinates (v up).
+/// for u and v) and filter, KHR_texture_transform's affine map of (u, v, 1), in glint's
+/// texture coordinates (v up), and the texture coordinate set it reads (0, or 1 for glTF's
+/// TEXCOORD_1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sampling {
     pub wrap: [u32; 2],
     pub nearest: bool,
     pub transform: [[f32; 3]; 2],
+    pub uv_set: u32,
 }
 
 impl Default for Sampling {
@@ -31,6 +33,7 @@ impl Default for Sampling {
             wrap: [TEXTURE_WRAP_REPEAT; 2],
             nearest: false,
             transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            uv_set: 0,
         }
     }
 }
@@ -293,6 +296,7 @@ impl TextureSet {
             | if sampling.nearest { TEXTURE_NEAREST } else { 0 };
         texture.transform_u = sampling.transform[0];
         texture.transform_v = sampling.transform[1];
+        texture.uv_set = sampling.uv_set;
         self.push(texture)
     }
 

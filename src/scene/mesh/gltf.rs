@@ -444,6 +444,8 @@ struct PrimitivePlan {
     positions: usize,
     normals: Option<usize>,
     uvs: Option<usize>,
+    /// TEXCOORD_1.
+    uvs1: Option<usize>,
     tangents: Option<usize>,
     /// COLOR_0, and whether it is a VEC4 (RGBA) rather than a VEC3 (RGB).
     colors: Option<(usize, bool)>,
@@ -483,6 +485,7 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             .ok_or_else(|| format!("{name}.attributes: no POSITION"))?;
         let normals = attribute(Semantic::Normals, "NORMAL", Type::Vec3)?;
         let uvs = attribute(Semantic::TexCoords(0), "TEXCOORD_0", Type::Vec2)?;
+        let uvs1 = attribute(Semantic::TexCoords(1), "TEXCOORD_1", Type::Vec2)?;
         let tangents = attribute(Semantic::Tangents, "TANGENT", Type::Vec4)?;
         let colors = match primitive
             .attributes
@@ -502,6 +505,7 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
         for (label, other) in [
             ("NORMAL", normals),
             ("TEXCOORD_0", uvs),
+            ("TEXCOORD_1", uvs1),
             ("TANGENT", tangents),
             ("COLOR_0", colors.map(|((a, _), count)| (a, count))),
         ] {
@@ -534,6 +538,7 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             positions,
             normals: normals.map(|(a, _)| a),
             uvs: uvs.map(|(a, _)| a),
+            uvs1: uvs1.map(|(a, _)| a),
             tangents: tangents.map(|(a, _)| a),
             colors: colors.map(|(a, _)| a),
             indices: indices.map(|(a, _)| a),
@@ -951,15 +956,18 @@ impl Decoder<'_> {
             None => Vec::new(),
         };
         // glTF's texture coordinates have v down (the image's top row at v = 0).
-        let uvs = match plan.uvs {
-            Some(a) => self
-                .layout(a, Type::Vec2, false)?
-                .floats::<2>()?
-                .into_iter()
-                .map(|[u, v]| Vec2::new(u, 1.0 - v))
-                .collect(),
-            None => Vec::new(),
+        let mut uvs = |accessor: Option<usize>| -> Result<Vec<Vec2>, String> {
+            Ok(match accessor {
+                Some(a) => self
+                    .layout(a, Type::Vec2, false)?
+                    .floats::<2>()?
+                    .into_iter()
+                    .map(|[u, v]| Vec2::new(u, 1.0 - v))
+                    .collect(),
+                None => Vec::new(),
+            })
         };
+        let (uvs, uvs1) = (uvs(plan.uvs)?, uvs(plan.uvs1)?);
         // glTF's tangents point along increasing u, and their w (±1) makes the bitangent
         // w · normal × tangent point along increasing v of glTF's v-up normal-map convention,
         // which is glint's v: both are kept as they are.
@@ -1011,6 +1019,7 @@ impl Decoder<'_> {
             positions,
             normals,
             uvs,
+            uvs1,
             tangents,
             colors,
             indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),

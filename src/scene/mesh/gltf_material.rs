@@ -127,14 +127,17 @@ pub(super) fn material(
         let tex_coord = transform
             .and_then(|t| t.tex_coord)
             .unwrap_or(info.tex_coord);
-        if tex_coord != 0 {
+        if tex_coord > 1 {
             warnings.push(format!(
-                "{field}: on TEXCOORD_{tex_coord}; glint reads TEXCOORD_0 only, so the texture is \
-                 ignored"
+                "{field}: on TEXCOORD_{tex_coord}; glint reads TEXCOORD_0 and TEXCOORD_1 only, \
+                 so the texture is ignored"
             ));
             return Ok(None);
         }
-        let mut sampling = Sampling::default();
+        let mut sampling = Sampling {
+            uv_set: tex_coord,
+            ..Sampling::default()
+        };
         if let Some(s) = root.textures[t].sampler {
             let s = exists(s.value(), root.samplers.len(), "sampler")
                 .map_err(|e| format!("textures[{t}].sampler: {e}"))?;
@@ -223,7 +226,17 @@ pub(super) fn material(
                     }),
                     extras: Default::default(),
                 };
-                image(&Some(info), "normalTexture")?.map(|i| (i, n.scale))
+                match image(&Some(info), "normalTexture")? {
+                    // Tangents (the file's or MikkTSpace's) follow TEXCOORD_0.
+                    Some((_, sampling)) if sampling.uv_set != 0 => {
+                        warnings.push(format!(
+                            "{field}: on TEXCOORD_1; glint reads normal maps on TEXCOORD_0 \
+                             only, so the texture is ignored"
+                        ));
+                        None
+                    }
+                    i => i.map(|i| (i, n.scale)),
+                }
             }
             None => None,
         },

@@ -67,6 +67,8 @@ pub(super) struct Geometry {
     normals: Vec<Vec3>,
     /// Texture coordinates (v up), as many as positions, or none.
     uvs: Vec<Vec2>,
+    /// glTF's TEXCOORD_1 (v up), as many as positions, or none.
+    uvs1: Vec<Vec2>,
     /// glTF's TANGENT (xyz along increasing u, w the bitangent's sign), as many as positions,
     /// or none.
     tangents: Vec<Vec4>,
@@ -342,6 +344,8 @@ pub(crate) fn load(
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
             let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+            let uvs1 =
+                (geometry.uvs1.len() == count).then(|| idx.map(|i| geometry.uvs1[i as usize]));
             let colors =
                 (geometry.colors.len() == count).then(|| idx.map(|i| geometry.colors[i as usize]));
             let tangents = corners
@@ -353,6 +357,7 @@ pub(crate) fn load(
                 normals,
                 material,
                 uvs,
+                uvs1,
                 tangents,
                 colors,
             });

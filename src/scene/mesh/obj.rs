@@ -315,6 +315,7 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
                         .chunks_exact(2)
                         .map(Vec2::from_slice)
                         .collect(),
+                    uvs1: Vec::new(),
                     tangents: Vec::new(),
                     colors: Vec::new(),
                     indices: mesh

@@ -92,6 +92,7 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
                 positions,
                 normals,
                 uvs: Vec::new(),
+                uvs1: Vec::new(),
                 tangents: Vec::new(),
                 colors: Vec::new(),
                 indices,
