@@ -356,3 +356,27 @@ fn bad_color_accessors_are_named_errors() {
     nan[4][0] = f32::NAN;
     refused(&nan, FLOAT_RGBA, &|_| {}, &["element 4", "outside [0, 1]"]);
 }
+
+/// A PLY file's `red green blue` (and `alpha`) uchar vertex properties become vertex colours:
+/// display colours, so sRGB-decoded; alpha linear (1 where absent).
+#[test]
+fn ply_vertex_colors_are_read_srgb_decoded() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+               property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n\
+               property uchar alpha\nelement face 1\nproperty list uchar int vertex_indices\n\
+               end_header\n-1 -1 0 255 0 0 255\n1 -1 0 0 128 0 51\n0 1 0 0 0 255 0\n3 0 1 2\n";
+    std::fs::write(dir.path().join("t.ply"), ply).unwrap();
+    let text = scene_text("type = \"diffuse\"\ncolor = [0.5, 0.5, 0.5]", 1, 1)
+        .replace("square.gltf", "t.ply");
+    let scene = load(dir.path(), &text).unwrap_or_else(|e| panic!("{e}"));
+    let srgb = glint::scene::image::srgb_to_linear;
+    assert_eq!(
+        scene.triangles[0].colors,
+        Some([
+            Vec4::new(1.0, 0.0, 0.0, 1.0),
+            Vec4::new(0.0, srgb(128.0 / 255.0), 0.0, 0.2),
+            Vec4::new(0.0, 0.0, 1.0, 0.0),
+        ])
+    );
+}
