@@ -117,6 +117,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
                 None => None,
             },
             roughness_and_metallic: None,
+            color_and_opacity: None,
         });
         materials.push(material);
         has_other_textures |= other_textures;

@@ -142,6 +142,9 @@ pub(super) struct FileTextures {
     normal: Option<((Rc<ImageSource>, Sampling), f32)>,
     /// OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, merged on load.
     roughness_and_metallic: Option<(Option<PathBuf>, Option<PathBuf>)>,
+    /// OBJ's colour (`map_Kd`, if any) and opacity (`map_d`) images, merged on load into the
+    /// colour texture (the opacity its alpha).
+    color_and_opacity: Option<(Option<PathBuf>, PathBuf)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -272,6 +275,13 @@ pub(crate) fn load(
                         if let Some((map, scale)) = &maps.normal {
                             m.normal_texture =
                                 load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
+                        }
+                        if let Some((color, opacity)) = &maps.color_and_opacity {
+                            m.color_texture = Some(
+                                textures
+                                    .color_and_opacity(color.as_deref(), opacity)
+                                    .map_err(|e| format!("material {name:?}: {e}"))?,
+                            );
                         }
                         if let Some((roughness, metallic)) = &maps.roughness_and_metallic {
                             m.roughness_texture = Some(
