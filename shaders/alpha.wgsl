@@ -1,7 +1,7 @@
 // Alpha (mirror: src/cpu/alpha.rs): glTF's alphaMode on triangles. MASK cuts holes where the
 // alpha is below the material's cutoff (leaves, fences); BLEND is stochastic transparency, a
 // ray passing through with probability 1 - alpha; OPAQUE ignores alpha. The alpha at a hit is
-// the material's opacity times its colour texture's alpha there. Every traversal (the scan,
+// the material's opacity times its colour texture's alpha and its vertex colour's alpha there. Every traversal (the scan,
 // the BVH, the ray queries) accepts a triangle hit only through hit_scene_triangle, so camera,
 // bounce and shadow rays all see the same holes. Spheres and quads are always opaque.
 // Compiled in only when a material is not opaque (HAS_ALPHA, src/shader.rs).
@@ -37,11 +37,16 @@ fn alpha_skips(index: u32, tri: Triangle, r: TriangleRay) -> bool {
         return false;
     }
     var alpha = m.opacity;
-    if HAS_TEXTURES && m.color_texture != NO_TEXTURE {
-        // The texture coordinates shading uses at this hit (intersect_scene): the same
-        // barycentrics, so the holes are where the colour texture shows them.
+    if (HAS_TEXTURES && m.color_texture != NO_TEXTURE) || HAS_VERTEX_COLORS {
+        // The barycentrics shading uses at this hit (intersect_scene), so the holes are where
+        // the colour texture and the vertex colours show them.
         let b = triangle_barycentrics(tri, r);
-        alpha *= texture_alpha(m.color_texture, triangle_uv(index, b));
+        if HAS_TEXTURES && m.color_texture != NO_TEXTURE {
+            alpha *= texture_alpha(m.color_texture, triangle_uv(index, b));
+        }
+        if HAS_VERTEX_COLORS {
+            alpha *= vertex_color(index, b).w;
+        }
     }
     if m.alpha_mode == ALPHA_MASK {
         return alpha < m.alpha_cutoff;

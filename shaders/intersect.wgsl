@@ -20,8 +20,9 @@ struct Hit {
     // Which primitive: PRIMITIVE_SPHERE, PRIMITIVE_QUAD or PRIMITIVE_TRIANGLE, and its index.
     primitive: u32,
     index: u32,
-    // Texture coordinates (texture.wgsl); computed only when HAS_TEXTURES.
-    uv: vec2<f32>,
+    // Texture coordinates, set 0 in xy and set 1 in zw (texture.wgsl's both_sets); computed
+    // only when HAS_TEXTURES.
+    uv: vec4<f32>,
     // A triangle hit's barycentrics (of v0, v1, v2), for its vertex tangents (normal_map.wgsl);
     // zero on other primitives.
     barycentrics: vec3<f32>,
@@ -180,7 +181,7 @@ fn intersect_scene(ray: Ray) -> Hit {
         hit.error = surface.error;
         hit.material = s.material;
         if HAS_TEXTURES {
-            hit.uv = sphere_uv(outward);
+            hit.uv = both_sets(sphere_uv(outward));
         }
     } else if HAS_TRIANGLES && closest.primitive == PRIMITIVE_TRIANGLE {
         let tri = triangles[closest.index];
@@ -211,7 +212,7 @@ fn intersect_scene(ray: Ray) -> Hit {
         hit.error = surface.error;
         hit.material = q.material;
         if HAS_TEXTURES {
-            hit.uv = vec2<f32>(a, b);
+            hit.uv = both_sets(vec2<f32>(a, b));
         }
     }
     hit.front_face = dot(outward, ray.dir) < 0.0;

@@ -14,6 +14,9 @@
 @group(0) @binding(21) var<storage, read> texels: array<vec4<f32>>;
 // One per triangle when the scene has textures (a placeholder otherwise).
 @group(0) @binding(22) var<storage, read> triangle_uvs: array<TriangleUvs>;
+// glTF's TEXCOORD_1, one per triangle when a texture reads it (HAS_TEXCOORD_1; a placeholder
+// otherwise).
+@group(0) @binding(35) var<storage, read> triangle_uvs1: array<TriangleUvs>;
 
 const PI_INV: f32 = 0.318309886183791;
 
@@ -43,9 +46,23 @@ fn sphere_uv(n: vec3<f32>) -> vec2<f32> {
 }
 
 // Interpolated vertex texture coordinates at barycentrics b (b.x for uv0).
-fn triangle_uv(index: u32, b: vec3<f32>) -> vec2<f32> {
-    let t = triangle_uvs[index];
+fn interpolated_uv(t: TriangleUvs, b: vec3<f32>) -> vec2<f32> {
     return b.x * t.uv0 + b.y * t.uv1 + b.z * t.uv2;
+}
+
+// A hit's texture coordinates: set 0 in xy, set 1 (glTF's TEXCOORD_1) in zw. Spheres, quads
+// and scenes without a texture on set 1 have one set, in both.
+fn both_sets(uv: vec2<f32>) -> vec4<f32> {
+    return vec4<f32>(uv, uv);
+}
+
+// Triangle `index`'s texture coordinates (both sets) at barycentrics b.
+fn triangle_uv(index: u32, b: vec3<f32>) -> vec4<f32> {
+    let uv = interpolated_uv(triangle_uvs[index], b);
+    if HAS_TEXCOORD_1 {
+        return vec4<f32>(uv, interpolated_uv(triangle_uvs1[index], b));
+    }
+    return both_sets(uv);
 }
 
 // Texel (x, y) of an image, counted from its bottom-left corner.
@@ -144,8 +161,14 @@ fn checker_lookup(t: Texture, uv: vec2<f32>) -> vec3<f32> {
     return select(t.color0, t.color1, half_sum != floor(half_sum));
 }
 
-fn texture_lookup(index: u32, uv: vec2<f32>) -> vec3<f32> {
+// The set of texture coordinates (uvs: set 0 in xy, set 1 in zw) texture t reads.
+fn texture_set(t: Texture, uvs: vec4<f32>) -> vec2<f32> {
+    return select(uvs.xy, uvs.zw, t.uv_set == 1u);
+}
+
+fn texture_lookup(index: u32, uvs: vec4<f32>) -> vec3<f32> {
     let t = textures[index];
+    let uv = texture_set(t, uvs);
     if t.kind == TEXTURE_CHECKER {
         return checker_lookup(t, uv);
     }
@@ -153,19 +176,20 @@ fn texture_lookup(index: u32, uv: vec2<f32>) -> vec3<f32> {
 }
 
 // A colour texture's alpha at uv: its image's alpha channel; a checker is opaque.
-fn texture_alpha(index: u32, uv: vec2<f32>) -> f32 {
+fn texture_alpha(index: u32, uvs: vec4<f32>) -> f32 {
     let t = textures[index];
+    let uv = texture_set(t, uvs);
     if t.kind == TEXTURE_CHECKER {
         return 1.0;
     }
     return image_alpha(t, transformed_uv(t, uv));
 }
 
-// The material at a hit with texture coordinates uv: textures multiply the constants (glTF's
+// The material at a hit with texture coordinates uv (both sets, see both_sets): textures multiply the constants (glTF's
 // rule; a TOML texture's constant is 1), before any BSDF or AOV reads them. A roughness
 // texture holds the roughness in x and the metallic factor in y (1 where the image gives none,
 // src/scene/texture.rs).
-fn material_at(m: Material, uv: vec2<f32>) -> Material {
+fn material_at(m: Material, uv: vec4<f32>) -> Material {
     var out = m;
     if HAS_TEXTURES {
         if m.color_texture != NO_TEXTURE {
@@ -205,7 +229,7 @@ fn material_at(m: Material, uv: vec2<f32>) -> Material {
 
 // The radiance material m emits at texture coordinates uv: its emission times its emission
 // texture there (sRGB-decoded), if it has one. Light sampling calls it at the point it samples.
-fn emission_at(m: Material, uv: vec2<f32>) -> vec3<f32> {
+fn emission_at(m: Material, uv: vec4<f32>) -> vec3<f32> {
     if HAS_TEXTURES && m.emission_texture != NO_TEXTURE {
         return m.emission * texture_lookup(m.emission_texture, uv);
     }

@@ -72,7 +72,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         (*path).radiance += firefly_clamp((*path).throughput * escaped, bounce);
         return true;
     }
-    let m = material_at(materials[hit.material], hit.uv);
+    let m = vertex_colored(material_at(materials[hit.material], hit.uv), hit);
     if HAS_TEXTURES && m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
         hit.shading_normal = normal_mapped(hit, m, -ray.dir);
     }

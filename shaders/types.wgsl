@@ -228,6 +228,8 @@ struct Texture {
     // The texture coordinates the lookup uses: (dot(transform_u, (u, v, 1)),
     // dot(transform_v, (u, v, 1))) (glTF's KHR_texture_transform; the identity otherwise).
     transform_u: vec3<f32>,
+    // The texture coordinate set the lookup reads: 0, or 1 (glTF's TEXCOORD_1).
+    uv_set: u32,
     transform_v: vec3<f32>,
 }
 
@@ -236,6 +238,14 @@ struct TriangleUvs {
     uv0: vec2<f32>,
     uv1: vec2<f32>,
     uv2: vec2<f32>,
+}
+
+// A triangle's vertex colours (glTF's COLOR_0, linear RGBA; white where the mesh has none),
+// multiplying the base colour and its alpha.
+struct TriangleColors {
+    c0: vec4<f32>,
+    c1: vec4<f32>,
+    c2: vec4<f32>,
 }
 
 // The emitter table's entry for the environment map (index 0).

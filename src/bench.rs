@@ -116,7 +116,9 @@ fn add_stress_mesh(scene: &mut Scene, triangles: u32) {
             normals: Some([mesh.normals[a], mesh.normals[b], mesh.normals[c]]),
             material,
             uvs: None,
+            uvs1: None,
             tangents: None,
+            colors: None,
         });
     }
 }

@@ -78,7 +78,9 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         textures,
         texels,
         triangle_uvs,
+        triangle_uvs1,
         triangle_tangents,
+        triangle_colors,
         environment_texels,
         environment_alias,
         lights,
@@ -104,7 +106,9 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     array("textures", bytemuck::cast_slice(textures));
     array("texels", bytemuck::cast_slice(texels));
     array("triangle uvs", bytemuck::cast_slice(triangle_uvs));
+    array("triangle uvs 1", bytemuck::cast_slice(triangle_uvs1));
     array("triangle tangents", bytemuck::cast_slice(triangle_tangents));
+    array("triangle colors", bytemuck::cast_slice(triangle_colors));
     array(
         "environment texels",
         bytemuck::cast_slice(environment_texels),

@@ -10,7 +10,7 @@ use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 33] = [
+pub const SHADER_PARTS: [(&str, &str); 34] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -55,6 +55,10 @@ pub const SHADER_PARTS: [(&str, &str); 33] = [
     ("pbr.wgsl", include_str!("../shaders/pbr.wgsl")),
     ("material.wgsl", include_str!("../shaders/material.wgsl")),
     ("texture.wgsl", include_str!("../shaders/texture.wgsl")),
+    (
+        "vertex_color.wgsl",
+        include_str!("../shaders/vertex_color.wgsl"),
+    ),
     ("alpha.wgsl", include_str!("../shaders/alpha.wgsl")),
     (
         "normal_map.wgsl",
@@ -299,6 +303,10 @@ pub struct KernelFeatures {
     /// Alpha-tested or blended materials (shaders/alpha.wgsl): without them every triangle hit
     /// is accepted as before, at the same cost.
     pub alpha: bool,
+    /// Meshes with vertex colours (glTF's COLOR_0, shaders/vertex_color.wgsl).
+    pub vertex_colors: bool,
+    /// Textures on the second texture coordinate set (glTF's TEXCOORD_1, shaders/texture.wgsl).
+    pub texcoord1: bool,
 }
 
 impl KernelFeatures {
@@ -321,6 +329,8 @@ impl KernelFeatures {
         lights: true,
         sun_disks: true,
         alpha: true,
+        vertex_colors: true,
+        texcoord1: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -358,6 +368,8 @@ impl KernelFeatures {
                 .iter()
                 .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
             alpha: has_alpha(&scene.materials),
+            vertex_colors: !scene.triangle_colors.is_empty(),
+            texcoord1: !scene.triangle_uvs1.is_empty(),
         }
     }
 
@@ -381,6 +393,8 @@ impl KernelFeatures {
             && needs(self.lights, other.lights)
             && needs(self.sun_disks, other.sun_disks)
             && needs(self.alpha, other.alpha)
+            && needs(self.vertex_colors, other.vertex_colors)
+            && needs(self.texcoord1, other.texcoord1)
     }
 
     /// The WGSL constants that turn the features on and off.
@@ -394,7 +408,8 @@ impl KernelFeatures {
              const AOVS: bool = {};\n\
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
-             const HAS_ALPHA: bool = {};\n",
+             const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
+             const HAS_TEXCOORD_1: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -411,7 +426,9 @@ impl KernelFeatures {
             self.environment,
             self.lights,
             self.sun_disks,
-            self.alpha
+            self.alpha,
+            self.vertex_colors,
+            self.textures && self.texcoord1
         )
     }
 }

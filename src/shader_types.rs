@@ -266,7 +266,8 @@ pub struct Texture {
     /// The texture coordinates the lookup uses: (u', v') = (transform_u · (u, v, 1),
     /// transform_v · (u, v, 1)) (glTF's KHR_texture_transform; the identity otherwise).
     pub transform_u: [f32; 3],
-    pub _pad0: u32,
+    /// The texture coordinate set the lookup reads: 0, or 1 (glTF's TEXCOORD_1).
+    pub uv_set: u32,
     pub transform_v: [f32; 3],
     pub _pad1: u32,
 }
@@ -289,7 +290,7 @@ impl Default for Texture {
             color1: [0.0; 3],
             sampling: 0,
             transform_u: [1.0, 0.0, 0.0],
-            _pad0: 0,
+            uv_set: 0,
             transform_v: [0.0, 1.0, 0.0],
             _pad1: 0,
         }
@@ -303,6 +304,16 @@ pub struct TriangleUvs {
     pub uv0: [f32; 2],
     pub uv1: [f32; 2],
     pub uv2: [f32; 2],
+}
+
+/// A triangle's vertex colours (glTF's COLOR_0, linear RGBA; white where the mesh has none),
+/// multiplying the base colour and its alpha. One per triangle when a mesh has them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TriangleColors {
+    pub c0: [f32; 4],
+    pub c1: [f32; 4],
+    pub c2: [f32; 4],
 }
 
 /// The emitter table's entry for the environment map (`index` 0).

@@ -305,7 +305,9 @@ emission = [1.0, 1.0, 1.0]
             normals: None,
             material: if k % 2 == 0 { bright } else { dim },
             uvs: None,
+            uvs1: None,
             tangents: None,
+            colors: None,
         });
     }
     scene

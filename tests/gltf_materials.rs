@@ -397,7 +397,7 @@ fn textured_glb() -> Vec<u8> {
 /// products are the same f32 operations on both sides, so they agree to an ulp or two).
 #[test]
 fn embedded_textures_multiply_their_factors_on_both_devices() {
-    use glint::cpu::texture::{material_at, Textures};
+    use glint::cpu::texture::{both_sets, material_at, Textures};
     let scene = load_glb(&textured_glb()).unwrap_or_else(|e| panic!("{e}"));
     let index = scene.triangles[0].material;
     let scene = scene.kernel_scene();
@@ -417,7 +417,7 @@ fn embedded_textures_multiply_their_factors_on_both_devices() {
     let srgb = |c: u8| glint::scene::image::srgb_to_linear(c as f32 / 255.0);
     let mut cpu = Vec::new();
     for &(i, uv) in &centres {
-        let m = material_at(&textures, &material, uv);
+        let m = material_at(&textures, &material, both_sets(uv));
         let c = COLOR_TEXELS[i];
         let want = Vec3::new(0.5 * srgb(c[0]), srgb(c[1]), 0.25 * srgb(c[2]));
         assert!(
@@ -515,22 +515,155 @@ fn bad_embedded_images_name_their_element() {
     }
 }
 
-/// A texture on TEXCOORD_1 is left out with a warning (glint reads TEXCOORD_0 only).
+/// A texture on TEXCOORD_2 (or later), and a normal map on TEXCOORD_1 (its tangents follow
+/// TEXCOORD_0), are left out with a warning.
 #[test]
-fn a_texture_on_the_second_coordinate_set_is_a_warning() {
+fn a_texture_on_the_third_coordinate_set_is_a_warning() {
     let material = serde_json::json!({"pbrMetallicRoughness": {
-        "baseColorTexture": {"index": 0, "texCoord": 1}
-    }});
+        "baseColorTexture": {"index": 0, "texCoord": 2}
+    }, "normalTexture": {"index": 0, "texCoord": 1}});
     let (mut json, bin) = triangle_gltf(material);
     json["images"] = serde_json::json!([{"uri": "missing.png"}]);
     json["textures"] = serde_json::json!([{"source": 0}]);
     let warnings = render_warnings(&json, &bin);
-    assert!(
-        warnings
-            .iter()
-            .any(|w| w.contains("baseColorTexture: on TEXCOORD_1")),
-        "{warnings:?}"
+    for needle in [
+        "baseColorTexture: on TEXCOORD_2",
+        "normalTexture: on TEXCOORD_1",
+    ] {
+        assert!(
+            warnings.iter().any(|w| w.contains(needle)),
+            "{needle}: {warnings:?}"
+        );
+    }
+}
+
+/// A square of two triangles facing a camera 5 in front of it, which sees 2.5 units across
+/// in 32² pixels, black behind it, no scattering: a pixel is what the square emits. Its
+/// emissive texture (COLOR_TEXELS, nearest) is on TEXCOORD_1, which lays the image over the
+/// square upright; TEXCOORD_0 puts every vertex on one texel (the top left).
+fn texcoord1_square(dir: &std::path::Path) -> glint::scene::KernelScene {
+    use base64::Engine as _;
+    let corners = [[-1.0f32, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+    let mut bin: Vec<u8> = Vec::new();
+    for [x, y] in corners {
+        bin.extend([x, y, 0.0].iter().flat_map(|f| f.to_le_bytes()));
+    }
+    for _ in corners {
+        bin.extend([0.1f32, 0.1].iter().flat_map(|f| f.to_le_bytes()));
+    }
+    // glTF's v points down: the image's top row at the square's top.
+    for [x, y] in corners {
+        bin.extend(
+            [(x + 1.0) / 2.0, (1.0 - y) / 2.0]
+                .iter()
+                .flat_map(|f| f.to_le_bytes()),
+        );
+    }
+    bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|i| i.to_le_bytes()));
+    let uri = format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(png(COLOR_TEXELS))
     );
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{
+            "attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2},
+            "indices": 3,
+            "material": 0
+        }]}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]},
+            "emissiveFactor": [1, 1, 1],
+            "emissiveTexture": {"index": 0, "texCoord": 1}
+        }],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9728}],
+        "images": [{"uri": uri}],
+        "buffers": [{"uri": "square.bin", "byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+            {"buffer": 0, "byteOffset": 80, "byteLength": 32},
+            {"buffer": 0, "byteOffset": 112, "byteLength": 12}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+             "min": [-1, -1, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}
+        ]
+    });
+    std::fs::write(dir.join("square.bin"), &bin).unwrap();
+    std::fs::write(dir.join("t.gltf"), serde_json::to_vec(&json).unwrap()).unwrap();
+    let vfov = 2.0 * (1.25f32 / 5.0).atan().to_degrees();
+    let text = format!(
+        "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+         vfov = {vfov}\n\n[render]\nwidth = 32\nheight = 32\nspp = 4\nmax_bounces = 0\n\
+         background = [0.0, 0.0, 0.0]\n\n[[meshes]]\nfile = \"t.gltf\"\n"
+    );
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    Scene::load(&dir.join("scene.toml"))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .kernel_scene()
+}
+
+/// A texture on TEXCOORD_1 reads the second set: its descriptor says so, the set is uploaded
+/// (v flipped as set 0 is), and the square shows each texel in its quadrant (the first set
+/// would show the top-left texel everywhere), on the CPU and on both GPU traversals, which
+/// agree.
+#[test]
+fn a_texture_on_texcoord_1_reads_the_second_set_on_both_devices() {
+    use glint::cpu::renderer::CpuRenderer;
+    use glint::gpu::{GpuRenderer, Traversal};
+    use glint::render::render_image;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = texcoord1_square(dir.path());
+    let texture = scene.textures[scene.materials[0].emission_texture as usize];
+    assert_eq!(texture.uv_set, 1);
+    assert!(glint::shader::KernelFeatures::of(&scene).texcoord1);
+    assert_eq!(scene.triangle_uvs1.len(), 2);
+    assert_eq!(scene.triangle_uvs1[0].uv1, [1.0, 0.0]);
+    assert_eq!(scene.triangle_uvs[0].uv1, [0.1, 0.9]);
+    let mut images = vec![(
+        "cpu",
+        render_image(&mut CpuRenderer::new(&scene), 4, 4).unwrap(),
+    )];
+    if let Some(ctx) = common::gpu() {
+        let mut software = GpuRenderer::with_traversal(ctx, &scene, Traversal::Software).unwrap();
+        images.push(("gpu software", render_image(&mut software, 4, 4).unwrap()));
+    }
+    if let Some(ctx) = common::gpu_with_ray_queries() {
+        let mut hardware = GpuRenderer::with_traversal(ctx, &scene, Traversal::Hardware).unwrap();
+        images.push(("gpu hardware", render_image(&mut hardware, 4, 4).unwrap()));
+    }
+    let srgb = |c: u8| glint::scene::image::srgb_to_linear(c as f32 / 255.0);
+    // Quadrant centres, top-left first as the texels.
+    let pixels = [(9u32, 9u32), (22, 9), (9, 22), (22, 22)];
+    for (device, image) in &images {
+        for (i, (x, y)) in pixels.into_iter().enumerate() {
+            let p = image.pixels[(y * image.width + x) as usize];
+            let want = COLOR_TEXELS[i].map(srgb);
+            for c in 0..3 {
+                assert!(
+                    (p[c] - want[c]).abs() < 1e-5,
+                    "{device}: quadrant {i} is {p:?}, want {want:?}"
+                );
+            }
+        }
+        let worst = images[0]
+            .1
+            .pixels
+            .iter()
+            .flatten()
+            .zip(image.pixels.iter().flatten())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f32::max);
+        assert!(worst < 1e-5, "{device}: differs from the CPU by {worst}");
+    }
 }
 
 /// A texture's sampler (wrap modes, magnification filter) and KHR_texture_transform reach its
@@ -703,7 +836,7 @@ fn rgba_png(texels: [[u8; 4]; 4]) -> Vec<u8> {
 /// colour is sRGB-decoded as before. An RGB texture's alpha is 1.
 #[test]
 fn the_base_color_textures_alpha_is_kept_linear() {
-    use glint::cpu::texture::{texture_alpha, Textures};
+    use glint::cpu::texture::{both_sets, texture_alpha, Textures};
     let texels = [
         [255, 0, 0, 0],
         [0, 255, 0, 64],
@@ -732,7 +865,7 @@ fn the_base_color_textures_alpha_is_kept_linear() {
         for (i, want) in alphas.iter().enumerate() {
             let (x, y) = ((i % 2) as f32, (i / 2) as f32);
             let uv = glam::Vec2::new((x + 0.5) / 2.0, 1.0 - (y + 0.5) / 2.0);
-            let got = m.opacity * texture_alpha(&textures, m.color_texture, uv);
+            let got = m.opacity * texture_alpha(&textures, m.color_texture, both_sets(uv));
             assert!(
                 (got - 0.5 * want).abs() < 1e-6,
                 "texel {i}: alpha {got}, want {}",

@@ -110,6 +110,37 @@ fn mean_colour(image: &Image, centre: Vec2, half: f32) -> Vec3 {
 /// expectation, away from the markers and the tile's edges, must overlap by 80% of their union
 /// at least (anti-aliased edges and noise account for the rest); the untransformed arrow's must
 /// overlap the render's by under 50% (the test can tell the two apart).
+/// BoxTexcoords (assimp's test model) puts its base colour on TEXCOORD_0 and its
+/// metallic-roughness texture on TEXCOORD_1, which differ: both are read, each texture's
+/// descriptor naming its set, with no warning about either.
+#[test]
+fn box_texcoords_reads_each_texture_on_its_own_set() {
+    let Some(path) = sample("BoxTexcoords-glTF/boxTexcoords.gltf") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("scene.toml");
+    let text = format!(
+        "[camera]\neye = [2.0, 2.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+         vfov = 40.0\n[render]\nwidth = 16\nheight = 16\nspp = 1\nmax_bounces = 1\n[[meshes]]\nfile = \"{}\"\n",
+        path.display()
+    );
+    std::fs::write(&scene_path, text).unwrap();
+    let out = dir.path().join("out.png");
+    let run = common::run_render("--cpu", &scene_path, &out);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(0), "{stderr}");
+    assert!(!stderr.contains("TEXCOORD"), "{stderr}");
+    let scene = Scene::load(&scene_path).unwrap_or_else(|e| panic!("{e}"));
+    let material = scene.triangles[0].material as usize;
+    let scene = scene.kernel_scene();
+    let m = scene.materials[material];
+    assert_eq!(scene.textures[m.color_texture as usize].uv_set, 0);
+    assert_eq!(scene.textures[m.roughness_texture as usize].uv_set, 1);
+    assert_eq!(scene.triangle_uvs1.len(), scene.triangles.len());
+    assert_ne!(scene.triangle_uvs1, scene.triangle_uvs);
+}
+
 #[test]
 fn the_texture_transform_test_shows_what_it_should() {
     let Some(path) = sample("textureTransform/TextureTransformTest.gltf") else {

@@ -8,7 +8,7 @@ use glint::shader::{
 };
 use glint::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs,
+    Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs,
 };
 use glint::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use naga::proc::Layouter;
@@ -236,11 +236,13 @@ fn rust_structs_match_wgsl_layout() {
             color1,
             sampling,
             transform_u,
+            uv_set,
             transform_v
         ]
     );
     assert_same_layout!(&module, TriangleUvs, "TriangleUvs", [uv0, uv1, uv2]);
     assert_same_layout!(&module, TriangleTangents, "TriangleTangents", [t0, t1, t2]);
+    assert_same_layout!(&module, TriangleColors, "TriangleColors", [c0, c1, c2]);
     // Ten vec4s: glTF's emissive and normal textures took the fifth, alpha and transmission
     // the sixth, volume attenuation the seventh, clearcoat the eighth and part of the ninth,
     // sheen the rest (a uniform-bound scene's materials stay far below the uniform limit).
@@ -391,6 +393,10 @@ fn every_feature_combination_validates() {
             volume: (bits / 5) % 2 == 1,
             // Likewise: on in half the combinations, with and without textures and triangles.
             alpha: (bits * 5 / 3) % 2 == 1,
+            // Likewise, with and without alpha and textures.
+            vertex_colors: (bits * 11 / 7) % 2 == 1,
+            // Likewise, with and without textures.
+            texcoord1: (bits * 13 / 9) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -431,6 +437,8 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         lights: false,
         sun_disks: false,
         alpha: false,
+        vertex_colors: false,
+        texcoord1: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

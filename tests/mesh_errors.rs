@@ -214,10 +214,11 @@ fn file_materials_are_mapped() {
     let lamp = by_name("t.obj/lamp");
     assert_eq!(lamp.kind, MaterialKind::Diffuse);
     assert_eq!(lamp.emitted_radiance, glam::Vec3::new(4.0, 5.0, 6.0));
-    assert_eq!(
-        by_name("t.obj/glass").kind,
-        MaterialKind::Dielectric { ior: 1.33 }
-    );
+    // d < 1 is blended opacity, not glass.
+    let glass = by_name("t.obj/glass");
+    assert_eq!(glass.kind, MaterialKind::Diffuse);
+    assert_eq!(glass.alpha.mode, glint::scene::AlphaMode::Blend);
+    assert_eq!(glass.alpha.opacity, 0.5);
     assert_eq!(by_name("t.obj/mirror").kind, MaterialKind::Specular);
     assert_eq!(scene.triangles.len(), 3);
 }
@@ -614,7 +615,7 @@ fn file_materials_out_of_glints_range() {
         &["material \"m\"", "Ke", "too bright"],
     );
     with_mtl(
-        "newmtl m\nd 0.5\nNi 1000\n",
+        "newmtl m\nPr 0.5\nNi 1000\n",
         &["material \"m\"", "Ni must be in [0.01, 100]", "1000"],
     );
     let material = |m: serde_json::Value| {

@@ -166,7 +166,16 @@ fn expected(i: u32, tangent: Vec3, bitangent: Vec3) -> Vec3 {
 }
 
 fn check(gltf: String, tangent: Vec3, bitangent: Vec3) {
-    let scene = load(gltf).unwrap_or_else(|e| panic!("{e}")).kernel_scene();
+    check_scene(
+        load(gltf).unwrap_or_else(|e| panic!("{e}")).kernel_scene(),
+        tangent,
+        bitangent,
+    );
+}
+
+/// The quad's shading normals against [`expected`], on the CPU and through the probe on the
+/// GPU.
+fn check_scene(scene: glint::scene::KernelScene, tangent: Vec3, bitangent: Vec3) {
     let cpu = cpu_normals(&scene);
     for (i, n) in cpu.iter().enumerate() {
         let want = expected(i as u32, tangent, bitangent);
@@ -206,6 +215,99 @@ fn the_files_tangents_are_used() {
         Vec3::Y,
         -Vec3::X,
     );
+}
+
+/// The quad's scene with its material given in the scene file: `normal_map` (TOML) on a `pbr`
+/// material, the file's image (`n.png`, upscaled) and scale.
+fn load_with_toml_material(gltf: String, normal_map: &str) -> Result<Scene, String> {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("quad.gltf"), gltf).unwrap();
+    // TOML textures are bilinear and repeat: 32 × 32 texels a quarter keep every probe ray's
+    // lookup within one quarter, so it reads that quarter's texel as the glTF file's nearest
+    // lookup does.
+    image::RgbImage::from_fn(64, 64, |x, y| {
+        image::Rgb(TEXELS[(y / 32 * 2 + x / 32) as usize])
+    })
+    .save(dir.path().join("n.png"))
+    .unwrap();
+    let text = format!(
+        "[camera]\neye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\n\
+         vfov = 20.0\n[render]\nwidth = 4\nheight = 4\nspp = 1\nmax_bounces = 1\n\
+         [materials.bumpy]\ntype = \"pbr\"\nbase_color = [0.8, 0.8, 0.8]\nmetallic = 0.0\n\
+         normal_map = {normal_map}\n[[meshes]]\nfile = \"quad.gltf\"\nmaterial = \"bumpy\"\n"
+    );
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).map_err(|e| e.to_string())
+}
+
+/// A scene file's `normal_map` (a table with the file and scale) tilts the quad's quarters
+/// as the glTF file's does, with MikkTSpace's tangents (the mesh has none), on both devices;
+/// the plain file name form reads the same image at scale 1.
+#[test]
+fn a_toml_normal_map_tilts_each_quarter() {
+    let table = format!("{{ file = \"n.png\", scale = {SCALE} }}");
+    let scene =
+        load_with_toml_material(quad_gltf(None, true), &table).unwrap_or_else(|e| panic!("{e}"));
+    let m = scene.materials.iter().find(|m| m.name == "bumpy").unwrap();
+    assert_eq!(m.normal_texture.map(|(_, s)| s), Some(SCALE));
+    check_scene(scene.kernel_scene(), Vec3::X, Vec3::Y);
+    let scene = load_with_toml_material(quad_gltf(None, true), "\"n.png\"")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let m = scene.materials.iter().find(|m| m.name == "bumpy").unwrap();
+    assert_eq!(m.normal_texture.map(|(_, s)| s), Some(1.0));
+}
+
+/// Bad `normal_map` values, and a TOML normal map on a mesh without texture coordinates, are
+/// errors naming the field (or the mesh file and material) and what is wrong.
+#[test]
+fn bad_toml_normal_maps_are_named_errors() {
+    for (value, uvs, needles) in [
+        (
+            "\"missing.png\"",
+            true,
+            vec!["materials.bumpy.normal_map", "missing.png"],
+        ),
+        (
+            "{ file = \"n.png\", scale = \"big\" }",
+            true,
+            vec!["materials.bumpy.normal_map.scale", "must be a number"],
+        ),
+        (
+            "{ file = \"n.png\", scale = inf }",
+            true,
+            vec!["materials.bumpy.normal_map.scale", "[-1e6, 1e6]"],
+        ),
+        (
+            "{ scale = 1.0 }",
+            true,
+            vec!["materials.bumpy.normal_map.file", "missing"],
+        ),
+        (
+            "{ texture = \"n.png\" }",
+            true,
+            vec!["materials.bumpy.normal_map", "unknown key: texture"],
+        ),
+        (
+            "0.5",
+            true,
+            vec!["materials.bumpy.normal_map", "must be \"file.png\""],
+        ),
+        (
+            "\"n.png\"",
+            false,
+            vec!["quad.gltf", "bumpy", "normal map", "texture coordinates"],
+        ),
+    ] {
+        let message = load_with_toml_material(quad_gltf(None, uvs), value)
+            .expect_err("the scene should be refused");
+        for needle in needles {
+            assert!(
+                message.contains(needle),
+                "{value}: {message:?} lacks {needle:?}"
+            );
+        }
+    }
 }
 
 /// A normal map on triangles without texture coordinates cannot be laid out: an error naming

@@ -124,12 +124,124 @@ fn emission_and_normal_maps_are_read_with_their_options() {
     assert_eq!(the_material(&scene).normal_texture.unwrap().1, 2.0);
 }
 
+/// `d` < 1 (or `Tr` > 0, Tr = 1 − d) is blended opacity on any material kind; Blender's
+/// `d 1.000000` on opaque materials leaves them opaque.
+#[test]
+fn dissolve_and_transparency_are_blended_opacity() {
+    use glint::scene::{Alpha, AlphaMode, MaterialKind};
+    let blend = |opacity: f32| Alpha {
+        mode: AlphaMode::Blend,
+        opacity,
+    };
+    for (mtl, kind, alpha) in [
+        (
+            "Kd 0.5 0.5 0.5\nd 0.25\n",
+            MaterialKind::Diffuse,
+            blend(0.25),
+        ),
+        (
+            "Kd 0.5 0.5 0.5\nTr 0.75\n",
+            MaterialKind::Diffuse,
+            blend(0.25),
+        ),
+        (
+            "Kd 0.5 0.5 0.5\nd 1.000000\n",
+            MaterialKind::Diffuse,
+            Alpha::OPAQUE,
+        ),
+        (
+            "Kd 0.5 0.5 0.5\nTr 0\n",
+            MaterialKind::Diffuse,
+            Alpha::OPAQUE,
+        ),
+        (
+            "Ks 0.9 0.9 0.9\nillum 3\nd 0.5\n",
+            MaterialKind::Specular,
+            blend(0.5),
+        ),
+    ] {
+        let (scene, _dir) = load(&format!("newmtl m\n{mtl}"));
+        let m = the_material(&scene);
+        assert_eq!((m.kind, m.alpha), (kind, alpha), "{mtl}");
+    }
+    // Blender's PBR statements with d.
+    let (scene, _dir) = load("newmtl m\nKd 1 1 1\nPr 0.5\nd 0.5\n");
+    let m = the_material(&scene);
+    assert!(matches!(m.kind, MaterialKind::Pbr { .. }), "{:?}", m.kind);
+    assert_eq!(m.alpha, blend(0.5));
+}
+
+/// `map_d`'s first channel becomes the colour texture's alpha (the material blended), merged
+/// with `map_Kd` where the material has one (at its size, the opacity image resampled
+/// nearest) and white where it has none (the colour stays `Kd`).
+#[test]
+fn an_opacity_map_is_the_colour_textures_alpha() {
+    use glint::scene::AlphaMode;
+    let srgb = |c: f32| glint::scene::image::srgb_to_linear(c / 255.0);
+    for (mtl, color, texels) in [
+        (
+            "Kd 0.5 0.5 0.5\nmap_d rough.png\n",
+            0.5,
+            vec![
+                [1.0, 1.0, 1.0, 64.0 / 255.0],
+                [1.0, 1.0, 1.0, 192.0 / 255.0],
+            ],
+        ),
+        (
+            "Kd 0.5 0.5 0.5\nmap_Kd glow.png\nmap_d -imfchan m rough.png\n",
+            1.0,
+            vec![[srgb(128.0), srgb(128.0), srgb(128.0), 64.0 / 255.0]],
+        ),
+    ] {
+        let (scene, _dir) = load(&format!("newmtl m\n{mtl}"));
+        let m = the_material(&scene);
+        assert_eq!(m.alpha.mode, AlphaMode::Blend, "{mtl}");
+        assert_eq!(m.alpha.opacity, 1.0, "{mtl}");
+        assert_eq!(m.color, glam::Vec3::splat(color), "{mtl}");
+        let t = scene.textures.descriptors[m.color_texture.expect("a colour texture") as usize];
+        let got = &scene.textures.texels[t.first_texel as usize..][..(t.width * t.height) as usize];
+        assert_eq!(got.len(), texels.len(), "{mtl}");
+        for (g, w) in got.iter().zip(&texels) {
+            for (a, b) in g.iter().zip(w) {
+                assert!(
+                    (a - b).abs() < 1e-6,
+                    "{mtl}: texels {got:?}, want {texels:?}"
+                );
+            }
+        }
+    }
+}
+
+/// Blender's exporter names map_Kd's RGBA image in map_d too: the image's alpha channel, not
+/// its first, is then the opacity.
+#[test]
+fn an_rgba_opacity_map_gives_its_alpha() {
+    let dir = tempfile::tempdir().unwrap();
+    write_files(
+        dir.path(),
+        "newmtl m\nKd 0.8 0.8 0.8\nmap_Kd leaf.png\nmap_d leaf.png\n",
+    );
+    image::RgbaImage::from_fn(1, 1, |_, _| image::Rgba([255, 0, 0, 51]))
+        .save(dir.path().join("leaf.png"))
+        .unwrap();
+    let scene = Scene::load(&dir.path().join("scene.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let m = the_material(&scene);
+    let t = scene.textures.descriptors[m.color_texture.expect("a colour texture") as usize];
+    let texel = scene.textures.texels[t.first_texel as usize];
+    assert_eq!(texel, [1.0, 0.0, 0.0, 0.2]);
+}
+
 #[test]
 fn bad_pbr_values_are_refused_naming_material_and_statement() {
     for (mtl, needles) in [
         ("newmtl m\nPr 1.5\n", vec!["\"m\"", "Pr", "[0, 1]", "1.5"]),
         ("newmtl m\nPm -0.5\n", vec!["\"m\"", "Pm", "[0, 1]"]),
         ("newmtl m\nPr rough\n", vec!["\"m\"", "Pr", "not a number"]),
+        (
+            "newmtl m\nd 1.5\n",
+            vec!["\"m\"", "d must be in [0, 1]", "1.5"],
+        ),
+        ("newmtl m\nTr -0.5\n", vec!["\"m\"", "Tr must be in [0, 1]"]),
         (
             "newmtl m\nPr 0.5\nmap_Pr -bm 1\n",
             vec!["\"m\"", "map_Pr", "no image"],

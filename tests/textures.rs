@@ -5,7 +5,7 @@ mod common;
 
 use common::probe::{run_probe, ProbeParams};
 use glam::{Vec2, Vec3};
-use glint::cpu::texture::{texture_lookup, Textures};
+use glint::cpu::texture::{both_sets, texture_lookup, Textures};
 use glint::scene::image::srgb_to_linear;
 use glint::scene::{KernelScene, Scene};
 use glint::shader_types::TriangleUvs;
@@ -61,7 +61,7 @@ fn lookups(scene: &KernelScene, texture: u32, uvs: &[Vec2]) -> Vec<(&'static str
     };
     let cpu = uvs
         .iter()
-        .map(|&uv| texture_lookup(&textures, texture, uv))
+        .map(|&uv| texture_lookup(&textures, texture, both_sets(uv)))
         .collect();
     let mut out = vec![("cpu", cpu)];
     if let Some(ctx) = common::gpu() {

@@ -1,7 +1,8 @@
 //! Alpha (WGSL side: `shaders/alpha.wgsl`): glTF's alphaMode on triangles. MASK cuts holes
 //! where the alpha is below the material's cutoff (leaves, fences); BLEND is stochastic
 //! transparency, a ray passing through with probability 1 − α; OPAQUE ignores alpha. The alpha
-//! at a hit is the material's opacity times its colour texture's alpha there. Every traversal
+//! at a hit is the material's opacity times its colour texture's and its vertex colour's alpha
+//! there. Every traversal
 //! accepts a triangle hit only through [`hit_scene_triangle`], so camera, bounce and shadow
 //! rays all see the same holes. Spheres and quads are always opaque.
 
@@ -9,8 +10,9 @@ use super::intersect::NO_HIT;
 use super::rng::{pcg_hash, rng_init};
 use super::texture::{texture_alpha, triangle_uv, Textures};
 use super::triangle::{hit_triangle, triangle_barycentrics, TriangleRay};
+use super::vertex_color::vertex_color;
 use crate::shader_types::{
-    Material, Params, Triangle, TriangleUvs, ALPHA_MASK, ALPHA_OPAQUE, NO_TEXTURE,
+    Material, Params, Triangle, TriangleColors, TriangleUvs, ALPHA_MASK, ALPHA_OPAQUE, NO_TEXTURE,
 };
 
 /// The streams alpha decisions hash: above every stream id a path reaches (1 + 3·bounce +
@@ -27,6 +29,11 @@ pub struct AlphaTest<'a> {
     pub materials: &'a [Material],
     pub textures: Textures<'a>,
     pub triangle_uvs: &'a [TriangleUvs],
+    /// The second set, where a texture reads it (else empty).
+    pub triangle_uvs1: &'a [TriangleUvs],
+    /// One per triangle when a mesh has vertex colours (the kernel's `HAS_VERTEX_COLORS`),
+    /// else empty.
+    pub triangle_colors: &'a [TriangleColors],
     /// The key of the segment being traced ([`alpha_segment_key`]).
     pub key: u32,
 }
@@ -52,12 +59,17 @@ pub fn alpha_skips(alpha: &AlphaTest, index: u32, tri: &Triangle, r: &TriangleRa
         return false;
     }
     let mut a = m.opacity;
-    if m.color_texture != NO_TEXTURE {
-        // The texture coordinates shading uses at this hit (`intersect_scene`): the same
-        // barycentrics, so the holes are where the colour texture shows them.
+    if m.color_texture != NO_TEXTURE || !alpha.triangle_colors.is_empty() {
+        // The barycentrics shading uses at this hit (`intersect_scene`), so the holes are where
+        // the colour texture and the vertex colours show them.
         let b = triangle_barycentrics(tri, r);
-        let uv = triangle_uv(&alpha.triangle_uvs[index as usize], b);
-        a *= texture_alpha(&alpha.textures, m.color_texture, uv);
+        if m.color_texture != NO_TEXTURE {
+            let uv = triangle_uv(alpha.triangle_uvs, alpha.triangle_uvs1, index, b);
+            a *= texture_alpha(&alpha.textures, m.color_texture, uv);
+        }
+        if let Some(colors) = alpha.triangle_colors.get(index as usize) {
+            a *= vertex_color(colors, b).w;
+        }
     }
     if m.alpha_mode == ALPHA_MASK {
         return a < m.alpha_cutoff;

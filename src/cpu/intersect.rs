@@ -4,7 +4,7 @@ use super::alpha::{hit_scene_triangle, AlphaTest};
 use super::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
 use super::shading_normal::valid_shading_normal;
 use super::surface::{parametric_point, sphere_point};
-use super::texture::{sphere_uv, triangle_uv};
+use super::texture::{both_sets, sphere_uv, triangle_uv};
 use super::triangle::{
     triangle_barycentrics, triangle_normal, triangle_ray, triangle_surface_point,
 };
@@ -13,7 +13,7 @@ use crate::shader_types::{
     BvhNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
     PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// The scene's surfaces as the kernel's intersection code reads them. With `bvh_nodes` empty,
 /// every ray tests every primitive (the kernel's `USE_BVH = false`).
@@ -27,6 +27,8 @@ pub struct Geometry<'a> {
     pub bvh_primitives: &'a [u32],
     /// One per triangle when `textured`.
     pub triangle_uvs: &'a [TriangleUvs],
+    /// The second set, where a texture reads it (else empty).
+    pub triangle_uvs1: &'a [TriangleUvs],
     /// Whether hits need texture coordinates (the kernel's `HAS_TEXTURES`).
     pub textured: bool,
     /// Alpha-tested and blended triangles (`alpha.rs`); off by default.
@@ -65,8 +67,9 @@ pub struct Hit {
     /// Which primitive: `PRIMITIVE_SPHERE`, `PRIMITIVE_QUAD` or `PRIMITIVE_TRIANGLE`, and its index.
     pub primitive: u32,
     pub index: u32,
-    /// Texture coordinates (`texture.rs`); computed only when `Geometry::textured`.
-    pub uv: Vec2,
+    /// Texture coordinates, set 0 in xy and set 1 in zw (`texture.rs`'s `both_sets`);
+    /// computed only when `Geometry::textured`.
+    pub uv: Vec4,
     /// A triangle hit's barycentrics (of v0, v1, v2), for its vertex tangents
     /// (`normal_map.rs`); zero on other primitives.
     pub barycentrics: Vec3,
@@ -226,13 +229,13 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
             front_face: false,
             primitive: 0,
             index: 0,
-            uv: Vec2::ZERO,
+            uv: Vec4::ZERO,
             barycentrics: Vec3::ZERO,
         };
     }
     // Zero: shade with the geometric normal.
     let mut shading = Vec3::ZERO;
-    let mut uv = Vec2::ZERO;
+    let mut uv = Vec4::ZERO;
     let mut barycentrics = Vec3::ZERO;
     let (outward, surface, material) = if closest.primitive == PRIMITIVE_SPHERE {
         let s = &geometry.spheres[closest.index as usize];
@@ -240,7 +243,7 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
         // reflected directions too long, and the error would grow with every bounce.
         let outward = (ray.origin + closest.t * ray.dir - Vec3::from(s.center)).normalize();
         if geometry.textured {
-            uv = sphere_uv(outward);
+            uv = both_sets(sphere_uv(outward));
         }
         (
             outward,
@@ -257,7 +260,12 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
                 .normalize();
         }
         if geometry.textured {
-            uv = triangle_uv(&geometry.triangle_uvs[closest.index as usize], b);
+            uv = triangle_uv(
+                geometry.triangle_uvs,
+                geometry.triangle_uvs1,
+                closest.index,
+                b,
+            );
         }
         // On the triangle's plane: v0 + b1 e1 + b2 e2, from the edges the normal is made of.
         (
@@ -272,7 +280,7 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
         let a = Vec3::from(q.u_dual).dot(w).clamp(0.0, 1.0);
         let b = Vec3::from(q.v_dual).dot(w).clamp(0.0, 1.0);
         if geometry.textured {
-            uv = Vec2::new(a, b);
+            uv = both_sets(Vec2::new(a, b));
         }
         (
             Vec3::from(q.normal),

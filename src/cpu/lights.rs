@@ -137,7 +137,7 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         // The emission where the sample lies (glTF's emissive texture).
         let m = &scene.materials[tri.material as usize];
         out.radiance = if m.emission_texture != NO_TEXTURE {
-            let uv = triangle_uv(&scene.triangle_uvs[e.index as usize], b);
+            let uv = triangle_uv(scene.triangle_uvs, scene.triangle_uvs1, e.index, b);
             emission_at(&scene.textures(), m, uv)
         } else {
             Vec3::from(m.emission)

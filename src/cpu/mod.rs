@@ -33,6 +33,7 @@ pub mod surface;
 pub mod texture;
 pub mod trace;
 pub mod triangle;
+pub mod vertex_color;
 pub mod volume;
 
 use glam::Vec3;

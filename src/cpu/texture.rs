@@ -8,7 +8,7 @@ use crate::shader_types::{
     Material, Texture, TriangleUvs, NO_TEXTURE, TEXTURE_CHECKER, TEXTURE_NEAREST,
     TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR,
 };
-use glam::{UVec2, Vec2, Vec3};
+use glam::{UVec2, Vec2, Vec3, Vec4};
 
 /// The same f32 as the WGSL literal.
 const PI_INV: f32 = std::f32::consts::FRAC_1_PI;
@@ -64,8 +64,27 @@ pub fn sphere_uv(n: Vec3) -> Vec2 {
 }
 
 /// Interpolated vertex texture coordinates at barycentrics `b` (`b.x` for `uv0`).
-pub fn triangle_uv(t: &TriangleUvs, b: Vec3) -> Vec2 {
+pub fn interpolated_uv(t: &TriangleUvs, b: Vec3) -> Vec2 {
     b.x * Vec2::from(t.uv0) + b.y * Vec2::from(t.uv1) + b.z * Vec2::from(t.uv2)
+}
+
+/// A hit's texture coordinates: set 0 in xy, set 1 (glTF's TEXCOORD_1) in zw. Spheres, quads
+/// and scenes without a texture on set 1 have one set, in both.
+pub fn both_sets(uv: Vec2) -> Vec4 {
+    Vec4::new(uv.x, uv.y, uv.x, uv.y)
+}
+
+/// Triangle `index`'s texture coordinates (both sets) at barycentrics `b`; `uvs1` (set 1) is
+/// empty, the kernel's `HAS_TEXCOORD_1` off, when no texture reads it.
+pub fn triangle_uv(uvs: &[TriangleUvs], uvs1: &[TriangleUvs], index: u32, b: Vec3) -> Vec4 {
+    let uv = interpolated_uv(&uvs[index as usize], b);
+    match uvs1.get(index as usize) {
+        Some(t) => {
+            let uv1 = interpolated_uv(t, b);
+            Vec4::new(uv.x, uv.y, uv1.x, uv1.y)
+        }
+        None => both_sets(uv),
+    }
 }
 
 /// Texel (x, y) of an image, counted from its bottom-left corner.
@@ -170,8 +189,18 @@ pub fn checker_lookup(t: &Texture, uv: Vec2) -> Vec3 {
     }
 }
 
-pub fn texture_lookup(textures: &Textures, index: u32, uv: Vec2) -> Vec3 {
+/// The set of texture coordinates (`uvs`: set 0 in xy, set 1 in zw) texture `t` reads.
+pub fn texture_set(t: &Texture, uvs: Vec4) -> Vec2 {
+    if t.uv_set == 1 {
+        Vec2::new(uvs.z, uvs.w)
+    } else {
+        Vec2::new(uvs.x, uvs.y)
+    }
+}
+
+pub fn texture_lookup(textures: &Textures, index: u32, uvs: Vec4) -> Vec3 {
     let t = &textures.descriptors[index as usize];
+    let uv = texture_set(t, uvs);
     if t.kind == TEXTURE_CHECKER {
         return checker_lookup(t, uv);
     }
@@ -179,19 +208,20 @@ pub fn texture_lookup(textures: &Textures, index: u32, uv: Vec2) -> Vec3 {
 }
 
 /// A colour texture's alpha at `uv`: its image's alpha channel; a checker is opaque.
-pub fn texture_alpha(textures: &Textures, index: u32, uv: Vec2) -> f32 {
+pub fn texture_alpha(textures: &Textures, index: u32, uvs: Vec4) -> f32 {
     let t = &textures.descriptors[index as usize];
+    let uv = texture_set(t, uvs);
     if t.kind == TEXTURE_CHECKER {
         return 1.0;
     }
     image_alpha(textures, t, transformed_uv(t, uv))
 }
 
-/// The material at a hit with texture coordinates `uv`: textures multiply the constants
+/// The material at a hit with texture coordinates `uv` (both sets, see [`both_sets`]): textures multiply the constants
 /// (glTF's rule; a TOML texture's constant is 1), before any BSDF or AOV reads them. A
 /// roughness texture holds the roughness in x and the metallic factor in y (1 where the
 /// image gives none, `src/scene/texture.rs`).
-pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
+pub fn material_at(textures: &Textures, m: &Material, uv: Vec4) -> Material {
     let mut out = *m;
     if m.color_texture != NO_TEXTURE {
         out.albedo = (Vec3::from(m.albedo) * texture_lookup(textures, m.color_texture, uv)).into();
@@ -233,7 +263,7 @@ pub fn material_at(textures: &Textures, m: &Material, uv: Vec2) -> Material {
 /// The radiance material `m` emits at texture coordinates `uv`: its emission times its
 /// emission texture there (sRGB-decoded), if it has one. Light sampling calls it at the point
 /// it samples.
-pub fn emission_at(textures: &Textures, m: &Material, uv: Vec2) -> Vec3 {
+pub fn emission_at(textures: &Textures, m: &Material, uv: Vec4) -> Vec3 {
     if m.emission_texture != NO_TEXTURE {
         return Vec3::from(m.emission) * texture_lookup(textures, m.emission_texture, uv);
     }

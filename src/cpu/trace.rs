@@ -15,13 +15,14 @@ use super::punctual::sun_disks_radiance;
 use super::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use super::surface::offset_ray_origin;
 use super::texture::{material_at, Textures};
+use super::vertex_color::vertex_colored;
 use super::volume::volume_transmittance;
 use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader::has_alpha;
 use crate::shader_types::{
     BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleNormals, TriangleTangents, TriangleUvs, NO_TEXTURE,
+    Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs, NO_TEXTURE,
     PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
@@ -43,8 +44,13 @@ pub struct SceneRefs<'a> {
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
     pub triangle_uvs: &'a [TriangleUvs],
+    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
+    /// empty.
+    pub triangle_uvs1: &'a [TriangleUvs],
     /// One per triangle when a material has a normal map, else empty.
     pub triangle_tangents: &'a [TriangleTangents],
+    /// One per triangle when a mesh has vertex colours, else empty.
+    pub triangle_colors: &'a [TriangleColors],
     /// Empty without an environment map.
     pub environment_texels: &'a [EnvironmentTexel],
     pub environment_alias: &'a [EnvironmentAlias],
@@ -75,7 +81,9 @@ impl<'a> SceneRefs<'a> {
             textures: &scene.textures,
             texels: &scene.texels,
             triangle_uvs: &scene.triangle_uvs,
+            triangle_uvs1: &scene.triangle_uvs1,
             triangle_tangents: &scene.triangle_tangents,
+            triangle_colors: &scene.triangle_colors,
             lights: &scene.lights,
             has_alpha: has_alpha(&scene.materials),
             alpha_key: 0,
@@ -108,12 +116,15 @@ impl<'a> SceneRefs<'a> {
             bvh_nodes: self.bvh_nodes,
             bvh_primitives: self.bvh_primitives,
             triangle_uvs: self.triangle_uvs,
+            triangle_uvs1: self.triangle_uvs1,
             textured: !self.textures.is_empty(),
             alpha: AlphaTest {
                 enabled: self.has_alpha,
                 materials: self.materials,
                 textures: self.textures(),
                 triangle_uvs: self.triangle_uvs,
+                triangle_uvs1: self.triangle_uvs1,
+                triangle_colors: self.triangle_colors,
                 key: self.alpha_key,
             },
         }
@@ -219,10 +230,14 @@ pub fn path_step(
         path.radiance += firefly_clamp(params, path.throughput * escaped, bounce);
         return true;
     }
-    let m = &material_at(
-        &scene.textures(),
-        &scene.materials[hit.material as usize],
-        hit.uv,
+    let m = &vertex_colored(
+        scene.triangle_colors,
+        &material_at(
+            &scene.textures(),
+            &scene.materials[hit.material as usize],
+            hit.uv,
+        ),
+        &hit,
     );
     if m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
         hit.shading_normal = normal_mapped(

@@ -288,6 +288,16 @@ impl<'a> GpuRenderer<'a> {
                     read_only,
                 ),
                 BufferNeed::new(
+                    "triangle texture coordinates (set 1)",
+                    array_bytes(&scene.triangle_uvs1),
+                    read_only,
+                ),
+                BufferNeed::new(
+                    "triangle vertex colours",
+                    array_bytes(&scene.triangle_colors),
+                    read_only,
+                ),
+                BufferNeed::new(
                     "environment map",
                     array_bytes(&scene.environment_texels),
                     read_only,
@@ -350,7 +360,14 @@ impl<'a> GpuRenderer<'a> {
             Vec::new()
         };
         let triangle_uvs = storage_buffer(ctx, "triangle texture coordinates", &scene.triangle_uvs);
+        let triangle_uvs1 = storage_buffer(
+            ctx,
+            "triangle texture coordinates (set 1)",
+            &scene.triangle_uvs1,
+        );
         let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
+        let triangle_colors =
+            storage_buffer(ctx, "triangle vertex colours", &scene.triangle_colors);
         let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
@@ -450,6 +467,8 @@ impl<'a> GpuRenderer<'a> {
             (21, read_only, &texels[0]),
             (22, read_only, &triangle_uvs),
             (28, read_only, &triangle_tangents),
+            (34, read_only, &triangle_colors),
+            (35, read_only, &triangle_uvs1),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
             (24, read_only, &lights),

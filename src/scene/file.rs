@@ -127,6 +127,9 @@ pub(super) struct MaterialToml {
     pub(super) alpha_mode: Option<S<String>>,
     pub(super) alpha: Option<S<Real>>,
     pub(super) alpha_cutoff: Option<S<Real>>,
+    /// Any type, on meshes: a tangent-space normal map, `"file.png"` or
+    /// `{ file = "file.png", scale = s }`.
+    pub(super) normal_map: Option<S<toml::Value>>,
 }
 
 /// `roughness = 0.3`, or anything else (`{ texture = "…" }`), which validation reads.

@@ -8,13 +8,13 @@ use super::light::LightKind;
 use super::{AlphaMode, Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
-    self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleNormals,
-    TriangleTangents, TriangleUvs, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE, MATERIAL_DIELECTRIC,
-    MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR, NO_TEXTURE,
-    PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
-    ROULETTE_OFF,
+    self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleColors,
+    TriangleNormals, TriangleTangents, TriangleUvs, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE,
+    MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR,
+    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
 #[derive(Clone, Debug)]
@@ -37,8 +37,13 @@ pub struct KernelScene {
     pub texels: Vec<[f32; 4]>,
     /// One per triangle when the scene has textures, else empty.
     pub triangle_uvs: Vec<TriangleUvs>,
+    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
+    /// empty.
+    pub triangle_uvs1: Vec<TriangleUvs>,
     /// One per triangle when a material has a normal map, else empty.
     pub triangle_tangents: Vec<TriangleTangents>,
+    /// One per triangle when a mesh has vertex colours, else empty.
+    pub triangle_colors: Vec<TriangleColors>,
     /// The environment map's texels and alias table (`environment.rs`); empty without one.
     pub environment_texels: Vec<EnvironmentTexel>,
     pub environment_alias: Vec<EnvironmentAlias>,
@@ -64,7 +69,9 @@ impl KernelScene {
             + bytes(&self.textures)
             + bytes(&self.texels)
             + bytes(&self.triangle_uvs)
+            + bytes(&self.triangle_uvs1)
             + bytes(&self.triangle_tangents)
+            + bytes(&self.triangle_colors)
             + bytes(&self.environment_texels)
             + bytes(&self.environment_alias)
             + bytes(&self.lights)
@@ -358,12 +365,35 @@ impl Scene {
                     })
                     .collect()
             },
+            triangle_uvs1: if self.textures.descriptors.iter().any(|t| t.uv_set == 1) {
+                self.triangles
+                    .iter()
+                    .map(|t| {
+                        let [uv0, uv1, uv2] = t.uvs1.unwrap_or_default().map(|uv| uv.into());
+                        TriangleUvs { uv0, uv1, uv2 }
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
             triangle_tangents: if self.materials.iter().any(|m| m.normal_texture.is_some()) {
                 self.triangles
                     .iter()
                     .map(|t| {
                         let [t0, t1, t2] = t.tangents.unwrap_or_default().map(|t| t.into());
                         TriangleTangents { t0, t1, t2 }
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            // White where a triangle has none: the colours multiply.
+            triangle_colors: if self.triangles.iter().any(|t| t.colors.is_some()) {
+                self.triangles
+                    .iter()
+                    .map(|t| {
+                        let [c0, c1, c2] = t.colors.unwrap_or([Vec4::ONE; 3]).map(|c| c.into());
+                        TriangleColors { c0, c1, c2 }
                     })
                     .collect()
             } else {

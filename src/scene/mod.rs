@@ -97,8 +97,12 @@ pub struct Triangle {
     pub material: u32,
     /// Texture coordinates at the vertices (v up), where the file gives them.
     pub uvs: Option<[Vec2; 3]>,
+    /// The second set (glTF's TEXCOORD_1), where the file gives it.
+    pub uvs1: Option<[Vec2; 3]>,
     /// Vertex tangents (xyz unit, w the bitangent's sign) where the material has a normal map.
     pub tangents: Option<[Vec4; 3]>,
+    /// Vertex colours (linear RGBA, glTF's COLOR_0), where the file gives them.
+    pub colors: Option<[Vec4; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

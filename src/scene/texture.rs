@@ -15,13 +15,15 @@ use std::path::{Path, PathBuf};
 pub const MAX_TOTAL_TEXELS: u64 = u32::MAX as u64;
 
 /// How a glTF texture reference reads its image: its sampler's wrap modes (`TEXTURE_WRAP_*`,
-/// for u and v) and filter, and KHR_texture_transform's affine map of (u, v, 1), in glint's
-/// texture coordinates (v up).
+/// for u and v) and filter, KHR_texture_transform's affine map of (u, v, 1), in glint's
+/// texture coordinates (v up), and the texture coordinate set it reads (0, or 1 for glTF's
+/// TEXCOORD_1).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sampling {
     pub wrap: [u32; 2],
     pub nearest: bool,
     pub transform: [[f32; 3]; 2],
+    pub uv_set: u32,
 }
 
 impl Default for Sampling {
@@ -31,6 +33,7 @@ impl Default for Sampling {
             wrap: [TEXTURE_WRAP_REPEAT; 2],
             nearest: false,
             transform: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            uv_set: 0,
         }
     }
 }
@@ -163,6 +166,85 @@ impl TextureSet {
             clamped,
         };
         self.add(key, &shown, image, TextureUse::RoughnessAndMetallic)
+            .map_err(|e| format!("texture {shown}: {e}"))
+    }
+
+    /// One colour texture from OBJ's colour (`map_Kd`, sRGB; white where absent) and opacity
+    /// (`map_d`: its alpha channel where it has one, else its first channel; linear) images, as the kernel reads a colour texture: the
+    /// colour in xyz, the opacity as its alpha. The opacity image is resampled (nearest) to the
+    /// colour image's size where they differ. The error names the image.
+    pub fn color_and_opacity(
+        &mut self,
+        color: Option<&Path>,
+        opacity: &Path,
+    ) -> Result<u32, String> {
+        let canonical = |p: &Path| {
+            p.canonicalize()
+                .unwrap_or_else(|_| p.to_owned())
+                .display()
+                .to_string()
+        };
+        // A key no file path has: both paths after a '#'.
+        let key = (
+            PathBuf::from(format!(
+                "#color={}#opacity={}",
+                color.map_or(String::new(), canonical),
+                canonical(opacity)
+            )),
+            TextureUse::Color,
+        );
+        if let Some(&index) = self.loaded.get(&key) {
+            return Ok(index);
+        }
+        let color_image = color
+            .map(|p| {
+                load_linear_image(p, Encoding::Srgb)
+                    .map_err(|e| format!("texture {}: {e}", p.display()))
+            })
+            .transpose()?;
+        let opacity_image = load_linear_image(opacity, Encoding::Linear)
+            .map_err(|e| format!("texture {}: {e}", opacity.display()))?;
+        let (width, height) = color_image
+            .as_ref()
+            .map_or((opacity_image.width, opacity_image.height), |i| {
+                (i.width, i.height)
+            });
+        let mut alpha = Vec::with_capacity(width as usize * height as usize);
+        for y in 0..height {
+            for x in 0..width {
+                // Nearest texel of an image of another size.
+                let xi = (u64::from(x) * u64::from(opacity_image.width) / u64::from(width)) as u32;
+                let yi =
+                    (u64::from(y) * u64::from(opacity_image.height) / u64::from(height)) as u32;
+                // A scalar map's value is its first channel; where the image has an alpha
+                // channel (Blender's exporter names map_Kd's RGBA image in map_d), its alpha.
+                alpha.push(if opacity_image.alpha.is_empty() {
+                    opacity_image.texel(xi, yi)[0]
+                } else {
+                    opacity_image.alpha(xi, yi)
+                });
+            }
+        }
+        let clamped = color_image
+            .as_ref()
+            .and_then(|i| i.clamped)
+            .or(opacity_image.clamped);
+        let texels = match color_image {
+            Some(i) => i.texels,
+            None => vec![[1.0; 3]; alpha.len()],
+        };
+        let shown = match color {
+            Some(c) => format!("{} and {}", c.display(), opacity.display()),
+            None => opacity.display().to_string(),
+        };
+        let image = LinearImage {
+            width,
+            height,
+            texels,
+            alpha,
+            clamped,
+        };
+        self.add(key, &shown, image, TextureUse::Color)
             .map_err(|e| format!("texture {shown}: {e}"))
     }
 
@@ -301,6 +383,7 @@ impl TextureSet {
             | if sampling.nearest { TEXTURE_NEAREST } else { 0 };
         texture.transform_u = sampling.transform[0];
         texture.transform_v = sampling.transform[1];
+        texture.uv_set = sampling.uv_set;
         self.push(texture)
     }
 

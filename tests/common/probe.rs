@@ -134,6 +134,8 @@ fn run_probe_with(
     let texels = storage_buffer(ctx, "texels", &scene.texels);
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
     let triangle_tangents = storage_buffer(ctx, "triangle tangents", &scene.triangle_tangents);
+    let triangle_colors = storage_buffer(ctx, "triangle colours", &scene.triangle_colors);
+    let triangle_uvs1 = storage_buffer(ctx, "triangle uvs 1", &scene.triangle_uvs1);
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let lights = storage_buffer(ctx, "lights", &scene.lights);
@@ -188,6 +190,8 @@ fn run_probe_with(
             (21, read_only, &texels),
             (22, read_only, &triangle_uvs),
             (28, read_only, &triangle_tangents),
+            (34, read_only, &triangle_colors),
+            (35, read_only, &triangle_uvs1),
             (18, read_only, &environment_texels),
             (19, read_only, &environment_alias),
             (24, read_only, &lights),

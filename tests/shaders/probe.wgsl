@@ -138,8 +138,8 @@ fn probe_texture(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    let uv = triangle_uv(id.x, vec3<f32>(1.0, 0.0, 0.0));
-    probe_out[id.x] = vec4<f32>(texture_lookup(probe.seed, uv), 0.0);
+    let uv = interpolated_uv(triangle_uvs[id.x], vec3<f32>(1.0, 0.0, 0.0));
+    probe_out[id.x] = vec4<f32>(texture_lookup(probe.seed, both_sets(uv)), 0.0);
 }
 
 // The material at a hit: material probe.seed of the bound scene at the texture coordinates of

@@ -128,6 +128,7 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
             clearcoat_roughness: source(maps.clearcoat_roughness)?,
             sheen_color: source(maps.sheen_color)?,
             sheen_roughness: source(maps.sheen_roughness)?,
+            color_and_opacity: None,
         });
         materials.push(material);
         has_other_textures |= other_textures;
@@ -487,10 +488,16 @@ fn image_source(
 
 /// A primitive, checked, with the accessors to read.
 struct PrimitivePlan {
+    /// `meshes[m].primitives[p]`, for messages.
+    name: String,
     positions: usize,
     normals: Option<usize>,
     uvs: Option<usize>,
+    /// TEXCOORD_1.
+    uvs1: Option<usize>,
     tangents: Option<usize>,
+    /// COLOR_0, and whether it is a VEC4 (RGBA) rather than a VEC3 (RGB).
+    colors: Option<(usize, bool)>,
     indices: Option<usize>,
     material: Option<usize>,
     triangles: u64,
@@ -527,11 +534,29 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             .ok_or_else(|| format!("{name}.attributes: no POSITION"))?;
         let normals = attribute(Semantic::Normals, "NORMAL", Type::Vec3)?;
         let uvs = attribute(Semantic::TexCoords(0), "TEXCOORD_0", Type::Vec2)?;
+        let uvs1 = attribute(Semantic::TexCoords(1), "TEXCOORD_1", Type::Vec2)?;
         let tangents = attribute(Semantic::Tangents, "TANGENT", Type::Vec4)?;
+        let colors = match primitive
+            .attributes
+            .get(&Checked::Valid(Semantic::Colors(0)))
+        {
+            Some(a) => {
+                let field = format!("{name}.attributes.COLOR_0");
+                let a = exists(a.value(), root.accessors.len(), "accessor")
+                    .map_err(|e| format!("{field}: {e}"))?;
+                let rgba = color_accessor(root, a).map_err(|e| format!("{field}: {e}"))?;
+                let kind = if rgba { Type::Vec4 } else { Type::Vec3 };
+                let layout = Layout::of(root, buffers, a, kind, false)?;
+                Some(((a, rgba), layout.count))
+            }
+            None => None,
+        };
         for (label, other) in [
             ("NORMAL", normals),
             ("TEXCOORD_0", uvs),
+            ("TEXCOORD_1", uvs1),
             ("TANGENT", tangents),
+            ("COLOR_0", colors.map(|((a, _), count)| (a, count))),
         ] {
             if let Some((a, count)) = other {
                 if count != vertices {
@@ -558,16 +583,63 @@ fn mesh_plan(root: &json::Root, buffers: &Buffers, m: usize) -> Result<Vec<Primi
             None => None,
         };
         plans.push(PrimitivePlan {
+            name,
             positions,
             normals: normals.map(|(a, _)| a),
             uvs: uvs.map(|(a, _)| a),
+            uvs1: uvs1.map(|(a, _)| a),
             tangents: tangents.map(|(a, _)| a),
+            colors: colors.map(|(a, _)| a),
             indices: indices.map(|(a, _)| a),
             material,
             triangles: indices.map_or(vertices, |(_, count)| count) as u64 / 3,
         });
     }
     Ok(plans)
+}
+
+/// Whether COLOR_0's accessor `a` is RGBA (VEC4) rather than RGB (VEC3), after checking it is
+/// one of the forms glTF allows: VEC3 or VEC4 of FLOAT, or of normalized UNSIGNED_BYTE or
+/// UNSIGNED_SHORT.
+fn color_accessor(root: &json::Root, a: usize) -> Result<bool, String> {
+    let accessor = &root.accessors[a];
+    let field = format!("accessors[{a}]");
+    let rgba = match accessor.type_ {
+        Checked::Valid(Type::Vec3) => false,
+        Checked::Valid(Type::Vec4) => true,
+        Checked::Valid(other) => {
+            return Err(format!(
+                "{field}: type {}, but COLOR_0 must be VEC3 or VEC4",
+                type_name(other)
+            ))
+        }
+        Checked::Invalid => return Err(format!("{field}.type: not a glTF accessor type")),
+    };
+    match accessor.component_type {
+        Checked::Valid(json::accessor::GenericComponentType(ComponentType::F32)) => {}
+        Checked::Valid(json::accessor::GenericComponentType(
+            c @ (ComponentType::U8 | ComponentType::U16),
+        )) => {
+            if !accessor.normalized {
+                return Err(format!(
+                    "{field}: componentType {} without \"normalized\": true; COLOR_0 must be \
+                     FLOAT or normalized UNSIGNED_BYTE or UNSIGNED_SHORT",
+                    component_name(c)
+                ));
+            }
+        }
+        Checked::Valid(json::accessor::GenericComponentType(c)) => {
+            return Err(format!(
+                "{field}: componentType {}; COLOR_0 must be FLOAT or normalized UNSIGNED_BYTE or \
+                 UNSIGNED_SHORT",
+                component_name(c)
+            ))
+        }
+        Checked::Invalid => {
+            return Err(format!("{field}.componentType: not a glTF component type"))
+        }
+    }
+    Ok(rgba)
 }
 
 /// Where an accessor's elements lie, checked against its buffer views.
@@ -938,15 +1010,18 @@ impl Decoder<'_> {
             None => Vec::new(),
         };
         // glTF's texture coordinates have v down (the image's top row at v = 0).
-        let uvs = match plan.uvs {
-            Some(a) => self
-                .layout(a, Type::Vec2, false)?
-                .floats::<2>()?
-                .into_iter()
-                .map(|[u, v]| Vec2::new(u, 1.0 - v))
-                .collect(),
-            None => Vec::new(),
+        let mut uvs = |accessor: Option<usize>| -> Result<Vec<Vec2>, String> {
+            Ok(match accessor {
+                Some(a) => self
+                    .layout(a, Type::Vec2, false)?
+                    .floats::<2>()?
+                    .into_iter()
+                    .map(|[u, v]| Vec2::new(u, 1.0 - v))
+                    .collect(),
+                None => Vec::new(),
+            })
         };
+        let (uvs, uvs1) = (uvs(plan.uvs)?, uvs(plan.uvs1)?);
         // glTF's tangents point along increasing u, and their w (±1) makes the bitangent
         // w · normal × tangent point along increasing v of glTF's v-up normal-map convention,
         // which is glint's v: both are kept as they are.
@@ -959,6 +1034,37 @@ impl Decoder<'_> {
                 .collect(),
             None => Vec::new(),
         };
+        // Linear RGB(A) multiplying the base colour: a VEC3's alpha is 1. Floats outside
+        // [0, 1] (or not finite) would make a surface reflect more light than reaches it.
+        let colors = match plan.colors {
+            Some((a, rgba)) => {
+                let colors: Vec<Vec4> = if rgba {
+                    self.layout(a, Type::Vec4, false)?
+                        .floats::<4>()?
+                        .into_iter()
+                        .map(Vec4::from)
+                        .collect()
+                } else {
+                    self.layout(a, Type::Vec3, false)?
+                        .floats::<3>()?
+                        .into_iter()
+                        .map(|c| Vec3::from(c).extend(1.0))
+                        .collect()
+                };
+                if let Some((i, c)) = colors
+                    .iter()
+                    .enumerate()
+                    .find(|(_, c)| !(c.cmpge(Vec4::ZERO).all() && c.cmple(Vec4::ONE).all()))
+                {
+                    return Err(format!(
+                        "{}.attributes.COLOR_0: accessors[{a}] element {i} is {c}, outside [0, 1]",
+                        plan.name
+                    ));
+                }
+                colors
+            }
+            None => Vec::new(),
+        };
         let flat: Vec<u32> = match plan.indices {
             Some(a) => self.layout(a, Type::Scalar, true)?.indices()?,
             None => (0..positions.len() as u32).collect(),
@@ -967,7 +1073,9 @@ impl Decoder<'_> {
             positions,
             normals,
             uvs,
+            uvs1,
             tangents,
+            colors,
             indices: flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         })
     }

@@ -181,6 +181,8 @@ pub(super) fn material(
     // Occlusion maps are for rasterisers (a path tracer finds the occlusion), so they are
     // ignored without a word.
     let mut other_textures = false;
+    // Pushed once `image` (which warns too) is done with `warnings`.
+    let mut normal_map_warning = None;
     let mut image = |info: &Option<json::texture::Info>, field: &str| {
         let Some(info) = info else {
             return Ok(None);
@@ -196,14 +198,17 @@ pub(super) fn material(
         let tex_coord = transform
             .and_then(|t| t.tex_coord)
             .unwrap_or(info.tex_coord);
-        if tex_coord != 0 {
+        if tex_coord > 1 {
             warnings.push(format!(
-                "{field}: on TEXCOORD_{tex_coord}; glint reads TEXCOORD_0 only, so the texture is \
-                 ignored"
+                "{field}: on TEXCOORD_{tex_coord}; glint reads TEXCOORD_0 and TEXCOORD_1 only, \
+                 so the texture is ignored"
             ));
             return Ok(None);
         }
-        let mut sampling = Sampling::default();
+        let mut sampling = Sampling {
+            uv_set: tex_coord,
+            ..Sampling::default()
+        };
         if let Some(s) = root.textures[t].sampler {
             let s = exists(s.value(), root.samplers.len(), "sampler")
                 .map_err(|e| format!("textures[{t}].sampler: {e}"))?;
@@ -292,7 +297,17 @@ pub(super) fn material(
                     }),
                     extras: Default::default(),
                 };
-                image(&Some(info), "normalTexture")?.map(|i| (i, n.scale))
+                match image(&Some(info), "normalTexture")? {
+                    // Tangents (the file's or MikkTSpace's) follow TEXCOORD_0.
+                    Some((_, sampling)) if sampling.uv_set != 0 => {
+                        normal_map_warning = Some(format!(
+                            "{field}: on TEXCOORD_1; glint reads normal maps on TEXCOORD_0 \
+                             only, so the texture is ignored"
+                        ));
+                        None
+                    }
+                    i => i.map(|i| (i, n.scale)),
+                }
             }
             None => None,
         },
@@ -326,6 +341,7 @@ pub(super) fn material(
             _ => None,
         },
     };
+    warnings.extend(normal_map_warning);
     // The coat's own normal map is not rendered yet: the coat takes the base's shading normal.
     if let Some(c) = clearcoat.as_ref().filter(|c| c.clearcoat_factor > 0.0) {
         if let Some(n) = &c.clearcoat_normal_texture {

@@ -75,9 +75,13 @@ pub(super) struct Geometry {
     normals: Vec<Vec3>,
     /// Texture coordinates (v up), as many as positions, or none.
     uvs: Vec<Vec2>,
+    /// glTF's TEXCOORD_1 (v up), as many as positions, or none.
+    uvs1: Vec<Vec2>,
     /// glTF's TANGENT (xyz along increasing u, w the bitangent's sign), as many as positions,
     /// or none.
     tangents: Vec<Vec4>,
+    /// Vertex colours (linear RGBA in [0, 1], glTF's COLOR_0), as many as positions, or none.
+    colors: Vec<Vec4>,
     indices: Vec<[u32; 3]>,
 }
 
@@ -152,6 +156,9 @@ pub(super) struct FileTextures {
     /// KHR_materials_sheen's sheenColorTexture (sRGB) and sheenRoughnessTexture (alpha).
     sheen_color: Option<(Rc<ImageSource>, Sampling)>,
     sheen_roughness: Option<(Rc<ImageSource>, Sampling)>,
+    /// OBJ's colour (`map_Kd`, if any) and opacity (`map_d`) images, merged on load into the
+    /// colour texture (the opacity its alpha).
+    color_and_opacity: Option<(Option<PathBuf>, PathBuf)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -332,6 +339,13 @@ pub(crate) fn load_placed(
                             m.normal_texture =
                                 load(&Some(map.clone()), TextureUse::Normal)?.map(|t| (t, *scale));
                         }
+                        if let Some((color, opacity)) = &maps.color_and_opacity {
+                            m.color_texture = Some(
+                                textures
+                                    .color_and_opacity(color.as_deref(), opacity)
+                                    .map_err(|e| format!("material {name:?}: {e}"))?,
+                            );
+                        }
                         if let Some((roughness, metallic)) = &maps.roughness_and_metallic {
                             m.roughness_texture = Some(
                                 textures
@@ -403,6 +417,10 @@ pub(crate) fn load_placed(
                 // A zero vertex normal cannot shade: the triangle is shaded flat.
                 .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
             let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+            let uvs1 =
+                (geometry.uvs1.len() == count).then(|| idx.map(|i| geometry.uvs1[i as usize]));
+            let colors =
+                (geometry.colors.len() == count).then(|| idx.map(|i| geometry.colors[i as usize]));
             let tangents = corners
                 .as_ref()
                 .and_then(|c| c.get(f))
@@ -412,7 +430,9 @@ pub(crate) fn load_placed(
                 normals,
                 material,
                 uvs,
+                uvs1,
                 tangents,
+                colors,
             });
             if triangles.len() > MAX_TRIANGLES {
                 return Err(format!(

@@ -5,7 +5,7 @@ use super::{
     ImageSource, MeshFile, MeshPart,
 };
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
-use crate::scene::{Material, MaterialKind};
+use crate::scene::{Alpha, AlphaMode, Material, MaterialKind};
 use glam::{Vec2, Vec3};
 use std::io::{BufRead, Read};
 use std::path::Path;
@@ -61,8 +61,8 @@ const UNREAD_PBR_STATEMENTS: &[&str] = &[
 /// One `.mtl` material as glint's, its texture maps, and warning lines (without the file):
 /// - `Pr`/`Pm`/`map_Pr`/`map_Pm` present → `pbr` with Kd, roughness `Pr` (else from `Ns` as
 ///   Blender's importer derives it, 1 − √(Ns/1000)), metallic `Pm` and ior `Ni`;
-/// - else d < 1 → dielectric with Ni (default 1.5); illum 3 or 5 → mirror with Ks (else Kd);
-///   else diffuse Kd;
+/// - else illum 3 or 5 → mirror with Ks (else Kd); else diffuse Kd;
+/// - `d` (or `Tr`, 1 − d) < 1 → alpha `blend` with opacity d (stochastic transparency);
 /// - Ke → emission, with `map_Ke` multiplying it (Ke 1 when only the map is given);
 /// - `map_Kd` multiplies a diffuse or pbr colour; `norm`, `map_Bump` or `bump` is a
 ///   tangent-space normal map, its `-bm` option the scale (Blender's importer reads these as
@@ -110,6 +110,14 @@ fn obj_material(
         Vec3::ZERO
     });
     let emission = check_emission(name, "Ke", ke)?;
+    // `d` (dissolve) is the opacity; `Tr` (transparency), which some exporters write in its
+    // place, is 1 − d. Blender writes `d 1.000000` on every opaque material: only d < 1 makes
+    // a material blended, so those stay opaque, at no alpha cost.
+    let opacity = match (m.dissolve, number("Tr")?) {
+        (Some(d), _) => unit("d", d)?,
+        (None, Some(tr)) => 1.0 - unit("Tr", tr)?,
+        (None, None) => 1.0,
+    };
     let is_pbr = PBR_STATEMENTS.iter().any(|k| param(k).is_some());
     let ior = m.optical_density.filter(|&n| n > 0.0).unwrap_or(1.5);
     let kind = if is_pbr {
@@ -119,12 +127,6 @@ fn obj_material(
                 .shininess
                 .map_or(0.5, |ns| 1.0 - (ns.clamp(0.0, 1000.0) / 1000.0).sqrt()),
         };
-        if m.dissolve.is_some_and(|d| d < 1.0) {
-            warnings.push(format!(
-                "material {name:?}: d (opacity) {} is ignored: a pbr material is opaque",
-                m.dissolve.unwrap_or(1.0)
-            ));
-        }
         MaterialKind::Pbr {
             roughness,
             metallic: unit("Pm", number("Pm")?.unwrap_or(0.0))?,
@@ -136,10 +138,6 @@ fn obj_material(
             attenuation_color: Vec3::ONE,
             attenuation_distance: None,
             layers: Default::default(),
-        }
-    } else if m.dissolve.is_some_and(|d| d < 1.0) {
-        MaterialKind::Dielectric {
-            ior: check_ior(name, "Ni", ior)?,
         }
     } else if matches!(m.illumination_model, Some(3) | Some(5)) {
         MaterialKind::Specular
@@ -161,7 +159,6 @@ fn obj_material(
         MaterialKind::Specular => {
             check_reflectance(name, "Ks", Vec3::from(m.specular.unwrap_or(kd.to_array())))?
         }
-        MaterialKind::Dielectric { .. } => Vec3::ONE,
         _ => check_reflectance(name, "Kd", kd)?,
     };
     let mut maps = FileTextures::default();
@@ -174,10 +171,17 @@ fn obj_material(
         roughness_texture: None,
         emission_texture: None,
         normal_texture: None,
-        alpha: crate::scene::Alpha::OPAQUE,
+        alpha: if opacity < 1.0 {
+            Alpha {
+                mode: AlphaMode::Blend,
+                opacity,
+            }
+        } else {
+            Alpha::OPAQUE
+        },
     };
     let mut other_textures = false;
-    // map_Kd is the diffuse or base colour: mirrors (Ks) and glass (clear) do not use it.
+    // map_Kd is the diffuse or base colour: mirrors (Ks) do not use it.
     if let Some((file, _)) = map(m.diffuse_texture.as_deref(), "map_Kd")? {
         if matches!(kind, MaterialKind::Diffuse | MaterialKind::Pbr { .. }) {
             // map_Kd replaces Kd (the kernel multiplies the colour by the texture).
@@ -186,6 +190,18 @@ fn obj_material(
         } else {
             other_textures = true;
         }
+    }
+    // map_d's first channel is the opacity: it becomes the colour texture's alpha, merged on
+    // load with map_Kd where the material reads that (white otherwise, so the colour is the
+    // constant's).
+    if let Some((file, _)) = map(m.dissolve_texture.as_deref(), "map_d")? {
+        let color = maps
+            .color
+            .take()
+            .and(map(m.diffuse_texture.as_deref(), "map_Kd")?)
+            .map(|(f, _)| f);
+        maps.color_and_opacity = Some((color, file));
+        material.alpha.mode = AlphaMode::Blend;
     }
     let map_pr = map(param("map_Pr"), "map_Pr")?.map(|(f, _)| f);
     let map_pm = map(param("map_Pm"), "map_Pm")?.map(|(f, _)| f);
@@ -216,7 +232,6 @@ fn obj_material(
         &m.ambient_texture,
         &m.specular_texture,
         &m.shininess_texture,
-        &m.dissolve_texture,
     ]
     .iter()
     .any(|t| t.is_some())
@@ -316,7 +331,9 @@ pub(super) fn read_obj(path: &Path) -> Result<MeshFile, String> {
                         .chunks_exact(2)
                         .map(Vec2::from_slice)
                         .collect(),
+                    uvs1: Vec::new(),
                     tangents: Vec::new(),
+                    colors: Vec::new(),
                     indices: mesh
                         .indices
                         .chunks_exact(3)

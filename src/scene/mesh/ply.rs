@@ -1,8 +1,9 @@
-//! PLY files (ASCII and binary), read by `ply-rs-bw`: vertices, optional normals, and faces
-//! (polygons split into fans). PLY carries no materials.
+//! PLY files (ASCII and binary), read by `ply-rs-bw`: vertices, optional normals and vertex
+//! colours, and faces (polygons split into fans). PLY carries no materials.
 
 use super::{one_line, read_mesh_bytes, Geometry, MeshFile, MeshPart};
-use glam::Vec3;
+use crate::scene::image::srgb_to_linear;
+use glam::{Vec3, Vec4};
 use std::path::Path;
 
 pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
@@ -34,6 +35,12 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
     let mut positions = Vec::with_capacity(vertices.len());
     let mut normals = Vec::new();
     let has_normals = vertices.first().is_some_and(|v| v.contains_key("nx"));
+    // Vertex colours as scanners and MeshLab write them: `red green blue` (and `alpha`) uchar,
+    // display colours (sRGB-decoded here), alpha linear.
+    let has_colors = vertices
+        .first()
+        .is_some_and(|v| matches!(v.get("red"), Some(Property::UChar(_))));
+    let mut colors = Vec::new();
     for (i, v) in vertices.iter().enumerate() {
         let get = |k: &str| {
             scalar(v, k).ok_or_else(|| format!("malformed PLY: vertex {i} has no numeric {k:?}"))
@@ -41,6 +48,22 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
         positions.push(Vec3::new(get("x")?, get("y")?, get("z")?));
         if has_normals {
             normals.push(Vec3::new(get("nx")?, get("ny")?, get("nz")?));
+        }
+        if has_colors {
+            let channel = |k: &str| match v.get(k) {
+                Some(Property::UChar(c)) => Ok(*c as f32 / 255.0),
+                _ => Err(format!("malformed PLY: vertex {i} has no uchar {k:?}")),
+            };
+            let alpha = match v.get("alpha") {
+                Some(Property::UChar(a)) => *a as f32 / 255.0,
+                _ => 1.0,
+            };
+            colors.push(Vec4::new(
+                srgb_to_linear(channel("red")?),
+                srgb_to_linear(channel("green")?),
+                srgb_to_linear(channel("blue")?),
+                alpha,
+            ));
         }
     }
     let faces = ply
@@ -92,7 +115,9 @@ pub(super) fn read_ply(path: &Path) -> Result<MeshFile, String> {
                 positions,
                 normals,
                 uvs: Vec::new(),
+                uvs1: Vec::new(),
                 tangents: Vec::new(),
+                colors,
                 indices,
             },
             None,

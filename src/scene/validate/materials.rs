@@ -415,6 +415,11 @@ pub(super) fn validate_materials(
             )?;
         }
         let alpha = alpha(m, &field)?;
+        let normal_texture = m
+            .normal_map
+            .as_ref()
+            .map(|n| normal_map(n, &field("normal_map"), folder, &mut textures))
+            .transpose()?;
         index_of.insert(name.clone(), materials.len() as u32);
         materials.push(Material {
             name: name.clone(),
@@ -424,7 +429,7 @@ pub(super) fn validate_materials(
             color_texture,
             roughness_texture,
             emission_texture: None,
-            normal_texture: None,
+            normal_texture,
             alpha,
         });
     }
@@ -487,6 +492,62 @@ fn alpha(m: &MaterialToml, field: &dyn Fn(&str) -> String) -> Result<Alpha, Fiel
         _ => AlphaMode::Opaque,
     };
     Ok(Alpha { mode, opacity })
+}
+
+/// `normal_map = "file.png"` or `{ file = "file.png", scale = s }` (relative to `folder`;
+/// `scale` finite, default 1): a tangent-space normal map read as glTF's normalTexture
+/// (linear, x and y times the scale). Returns its index in `textures` and the scale.
+fn normal_map(
+    x: &S<toml::Value>,
+    field: &str,
+    folder: &Path,
+    textures: &mut TextureSet,
+) -> Result<(u32, f32), FieldError> {
+    let expected = "must be \"file.png\" or { file = \"file.png\", scale = s }";
+    let (file, scale) = match x.get_ref() {
+        toml::Value::String(file) => (file.as_str(), 1.0),
+        toml::Value::Table(table) => {
+            if let Some(key) = table
+                .keys()
+                .find(|k| !matches!(k.as_str(), "file" | "scale"))
+            {
+                return fail(x.span(), field, format!("{expected}; unknown key: {key}"));
+            }
+            let Some(file) = table.get("file").and_then(|f| f.as_str()) else {
+                return fail(
+                    x.span(),
+                    format!("{field}.file"),
+                    "missing: the normal map's image file (a string)",
+                );
+            };
+            let scale = match table.get("scale") {
+                None => 1.0,
+                Some(toml::Value::Float(v)) => *v,
+                Some(toml::Value::Integer(v)) => *v as f64,
+                Some(other) => {
+                    return fail(
+                        x.span(),
+                        format!("{field}.scale"),
+                        format!("must be a number, got {other}"),
+                    )
+                }
+            };
+            // glTF's scale may be any finite number; within f32's range here.
+            if !scale.is_finite() || scale.abs() > 1e6 {
+                return fail(
+                    x.span(),
+                    format!("{field}.scale"),
+                    format!("must be a number in [-1e6, 1e6], got {scale}"),
+                );
+            }
+            (file, scale)
+        }
+        other => return fail(x.span(), field, format!("{expected}, got {other}")),
+    };
+    let index = textures
+        .image(&folder.join(file), TextureUse::Normal)
+        .or_else(|message| fail(x.span(), field, format!("{file}: {message}")))?;
+    Ok((index, scale as f32))
 }
 
 /// A texture as written in a material field: `{ texture = "file" }` (relative to `folder`) or
