@@ -2,6 +2,7 @@
 # in glTF's Y-up frame, looking at the origin, vertical field of view), an equirectangular
 # environment map turned to glint's orientation, the same bounces, a near-box pixel filter,
 # linear EXR out. Usage: blender -b --python render.py -- MODEL ENV OUT.exr SIZE SPP EYE_Z VFOV
+# [EYE_X EYE_Y] (the eye moved across, still looking along −z: glint's target (EYE_X, EYE_Y, 0))
 import bpy, math, sys
 import numpy
 # Debian 12 Blender 3.4 glTF importer uses np.bool, which newer NumPy removed.
@@ -9,15 +10,16 @@ if not hasattr(numpy, "bool") or numpy.bool is not bool:
     numpy.bool = bool
 argv = sys.argv[sys.argv.index("--") + 1:]
 model, env, out, size, spp, eye_z, vfov = argv[0], argv[1], argv[2], int(argv[3]), int(argv[4]), float(argv[5]), float(argv[6])
+eye_x, eye_y = (float(argv[7]), float(argv[8])) if len(argv) > 8 else (0.0, 0.0)
 bpy.ops.wm.read_factory_settings(use_empty=True)
 bpy.ops.import_scene.gltf(filepath=model)
 scene = bpy.context.scene
-# glTF (x, y, z) is Blender (x, -z, y): glint's eye (0, 0, eye_z) is Blender (0, -eye_z, 0).
+# glTF (x, y, z) is Blender (x, -z, y): glint's eye (x, y, eye_z) is Blender (x, -eye_z, y).
 cam_data = bpy.data.cameras.new("cam")
 cam_data.sensor_fit = 'VERTICAL'
 cam_data.angle_y = math.radians(vfov)
 cam = bpy.data.objects.new("cam", cam_data)
-cam.location = (0.0, -eye_z, 0.0)
+cam.location = (eye_x, -eye_z, eye_y)
 cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
 scene.collection.objects.link(cam)
 scene.camera = cam
