@@ -572,8 +572,8 @@ fn used_extensions_get_one_warning() {
     let (mut json, bin) = triangle_gltf();
     json["extensionsUsed"] = serde_json::json!([
         "KHR_texture_transform",
-        "KHR_materials_sheen",
-        "KHR_materials_clearcoat"
+        "KHR_materials_iridescence",
+        "KHR_materials_anisotropy"
     ]);
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
@@ -592,7 +592,7 @@ fn used_extensions_get_one_warning() {
     assert_eq!(warnings.len(), 1, "{stderr}");
     assert!(
         warnings[0].contains("t.gltf: uses glTF extensions")
-            && warnings[0].contains("KHR_materials_clearcoat, KHR_materials_sheen")
+            && warnings[0].contains("KHR_materials_anisotropy, KHR_materials_iridescence")
             && !warnings[0].contains("KHR_texture_transform"),
         "{stderr}"
     );
