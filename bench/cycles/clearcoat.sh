@@ -18,27 +18,5 @@ sky=$assets/royal_esplanade_1k.hdr
 eye_x=-1.0
 eye_y=0.35
 eye_z=19.5
-cat > "$out/clearcoat.toml" <<TOML
-[camera]
-eye = [$eye_x, $eye_y, $eye_z]
-target = [$eye_x, $eye_y, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 40.0
-
-[render]
-width = $size
-height = $size
-spp = $spp
-max_bounces = 8
-
-[environment]
-file = "$sky"
-
-[[meshes]]
-file = "$model"
-TOML
-glint=${GLINT:-$here/../../target/release/glint}
-"$glint" render "$out/clearcoat.toml" --cpu -o "$out/clearcoat_glint.exr"
-blender -b --python "$here/render.py" -- "$model" "$sky" "$out/clearcoat_cycles.exr" \
-    "$size" "$spp" "$eye_z" 40 "$eye_x" "$eye_y" > "$out/blender.log" 2>&1
+"$here/side_by_side.sh" "$out" clearcoat "$model" "$sky" "$size" "$spp" $eye_x $eye_y $eye_z
 python3 "$here/compare.py" "$out/clearcoat_glint.exr" "$out/clearcoat_cycles.exr" "$out/side.png"

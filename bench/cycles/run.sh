@@ -12,28 +12,6 @@ spp=${3:-256}
 assets=${GLINT_ASSETS:-$here/../../../shared/assets}
 model=$assets/DamagedHelmet.glb
 sky=$assets/royal_esplanade_1k.hdr
-cat > "$out/helmet.toml" <<TOML
-[camera]
-eye = [0.0, 0.0, 3.2]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 40.0
-
-[render]
-width = $size
-height = $size
-spp = $spp
-max_bounces = 8
-
-[environment]
-file = "$sky"
-
-[[meshes]]
-file = "$model"
-TOML
-glint=${GLINT:-$here/../../target/release/glint}
-"$glint" render "$out/helmet.toml" --cpu -o "$out/helmet_glint.exr"
-blender -b --python "$here/render.py" -- "$model" "$sky" "$out/helmet_cycles.exr" \
-    "$size" "$spp" 3.2 40 > "$out/blender.log" 2>&1
+"$here/side_by_side.sh" "$out" helmet "$model" "$sky" "$size" "$spp" 0.0 0.0 3.2
 python3 "$here/compare.py" "$out/helmet_glint.exr" "$out/helmet_cycles.exr" "$out/side.png" \
     0,0,40,40 216,0,256,60 100,100,156,140 110,200,150,240
