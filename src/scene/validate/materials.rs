@@ -497,6 +497,20 @@ fn alpha(m: &MaterialToml, field: &dyn Fn(&str) -> String) -> Result<Alpha, Fiel
 /// `normal_map = "file.png"` or `{ file = "file.png", scale = s }` (relative to `folder`;
 /// `scale` finite, default 1): a tangent-space normal map read as glTF's normalTexture
 /// (linear, x and y times the scale). Returns its index in `textures` and the scale.
+/// A texture table's optional `scale` (1 when absent), an integer or a float.
+fn table_scale(x: &S<toml::Value>, table: &toml::Table, field: &str) -> Result<f64, FieldError> {
+    match table.get("scale") {
+        None => Ok(1.0),
+        Some(toml::Value::Float(v)) => Ok(*v),
+        Some(toml::Value::Integer(v)) => Ok(*v as f64),
+        Some(other) => fail(
+            x.span(),
+            format!("{field}.scale"),
+            format!("must be a number, got {other}"),
+        ),
+    }
+}
+
 fn normal_map(
     x: &S<toml::Value>,
     field: &str,
@@ -520,18 +534,7 @@ fn normal_map(
                     "missing: the normal map's image file (a string)",
                 );
             };
-            let scale = match table.get("scale") {
-                None => 1.0,
-                Some(toml::Value::Float(v)) => *v,
-                Some(toml::Value::Integer(v)) => *v as f64,
-                Some(other) => {
-                    return fail(
-                        x.span(),
-                        format!("{field}.scale"),
-                        format!("must be a number, got {other}"),
-                    )
-                }
-            };
+            let scale = table_scale(x, table, field)?;
             // glTF's scale may be any finite number; within f32's range here.
             if !scale.is_finite() || scale.abs() > 1e6 {
                 return fail(
@@ -597,18 +600,7 @@ fn texture(
                 }
                 *out = color;
             }
-            let scale = match table.get("scale") {
-                None => 1.0,
-                Some(toml::Value::Float(v)) => *v,
-                Some(toml::Value::Integer(v)) => *v as f64,
-                Some(other) => {
-                    return fail(
-                        x.span(),
-                        format!("{field}.scale"),
-                        format!("must be a number, got {other}"),
-                    )
-                }
-            };
+            let scale = table_scale(x, table, field)?;
             if !(scale > 0.0 && scale <= 1e6) {
                 return fail(
                     x.span(),
