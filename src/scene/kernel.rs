@@ -376,7 +376,7 @@ impl Scene {
             } else {
                 Vec::new()
             },
-            triangle_tangents: if self.materials.iter().any(|m| m.normal_texture.is_some()) {
+            triangle_tangents: if self.materials.iter().any(|m| m.has_normal_map()) {
                 self.triangles
                     .iter()
                     .map(|t| {

@@ -231,6 +231,16 @@ pub struct Material {
     pub alpha: Alpha,
 }
 
+impl Material {
+    /// Whether the material has a normal map (its own, or its coat's), which needs vertex
+    /// tangents.
+    pub fn has_normal_map(&self) -> bool {
+        self.normal_texture.is_some()
+            || matches!(&self.kind, MaterialKind::Pbr { layers, .. }
+                if layers.clearcoat_normal_texture.is_some())
+    }
+}
+
 /// How a material's alpha (its opacity times its colour texture's alpha) is used: glTF's
 /// alphaMode.
 #[derive(Clone, Copy, Debug, PartialEq)]
