@@ -157,6 +157,9 @@ pub struct RenderSettings {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MaterialKind {
     Diffuse,
+    /// KHR_materials_unlit: reflects nothing, emits `emitted_radiance` (the base colour) times
+    /// the colour texture and the vertex colour.
+    Unlit,
     Specular,
     /// GGX microfacet conductor; roughness in [0, 1], GGX alpha = roughness² (unused where
     /// [`Material::roughness_texture`] is set).

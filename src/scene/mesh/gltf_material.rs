@@ -371,7 +371,7 @@ pub(super) fn material(
         return Ok((
             Material {
                 name,
-                kind: MaterialKind::Diffuse,
+                kind: MaterialKind::Unlit,
                 color: Vec3::ZERO,
                 emitted_radiance: color,
                 color_texture: None,
