@@ -62,19 +62,12 @@ fn clearcoat_transmitted_o(l: ClearcoatLobe) -> f32 {
     return 1.0 - l.weight * l.albedo_o;
 }
 
-// wo, wi in the local frame, both above the surface.
+// wo, wi in the coat's local frame (about its own normal); with either below it the coat's
+// lobe is black, and below it wi dims the layers under the coat as its mirror image above
+// does (|cos|; see clearcoat_eval in the mirror for why).
 fn clearcoat_eval(l: ClearcoatLobe, wo: vec3<f32>, wi: vec3<f32>) -> ClearcoatEval {
-    let h = normalize(wo + wi);
-    let c = clamp(1.0 - dot(wo, h), 0.0, 1.0);
-    let s5 = c * c * c * c * c;
-    let fresnel = CLEARCOAT_F0 + (1.0 - CLEARCOAT_F0) * s5;
-    let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
-    var f_cos = fresnel * ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z);
-    let ab_i = ggx_albedo(wi.z, l.alpha);
+    let ab_i = ggx_albedo(abs(wi.z), l.alpha);
     let e_i = ab_i.x + ab_i.y;
-    if l.e_average < 1.0 {
-        f_cos += l.ms * (1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z;
-    }
     let albedo_i = clearcoat_layer_albedo(ab_i.x, ab_i.y, e_i, l.ms);
     let passed = (1.0 - l.weight * l.albedo_o) * (1.0 - l.weight * albedo_i);
     let room = 1.0 - l.weight * l.albedo_average;
@@ -83,5 +76,17 @@ fn clearcoat_eval(l: ClearcoatLobe, wo: vec3<f32>, wi: vec3<f32>) -> ClearcoatEv
         below_broad = passed / room;
     }
     let below_narrow = min(1.0 - l.weight * l.albedo_o, 1.0 - l.weight * albedo_i);
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return ClearcoatEval(0.0, below_broad, below_narrow);
+    }
+    let h = normalize(wo + wi);
+    let c = clamp(1.0 - dot(wo, h), 0.0, 1.0);
+    let s5 = c * c * c * c * c;
+    let fresnel = CLEARCOAT_F0 + (1.0 - CLEARCOAT_F0) * s5;
+    let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
+    var f_cos = fresnel * ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z);
+    if l.e_average < 1.0 {
+        f_cos += l.ms * (1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z;
+    }
     return ClearcoatEval(l.weight * f_cos, below_broad, below_narrow);
 }

@@ -149,6 +149,7 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> Ligh
         if HAS_TEXTURES && m.emission_texture != NO_TEXTURE {
             out.radiance = emission_at(m, triangle_uv(e.index, b));
         }
+        out.radiance = vertex_colored_emission(m, e.index, b, out.radiance);
         return out;
     }
     if emitter_is_quad(e.primitive) {

@@ -24,14 +24,16 @@ fn is_delta(m: Material) -> bool {
 
 // f * cos(theta_i) for light arriving from wi and leaving towards wo (n faces wo; front_face says
 // whether that is the outside). Zero for delta lobes and for wi below the surface (light
-// sampling's shadow rays do not pass through surfaces).
-fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, front_face: bool) -> vec3<f32> {
+// sampling's shadow rays do not pass through surfaces). coat_n, facing wo too, is the pbr
+// coat's own shading normal (KHR_materials_clearcoat's: n itself where nothing tilts it).
+fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, front_face: bool) -> vec3<f32> {
     let cos_i = dot(wi, n);
     if cos_i <= 0.0 || is_delta(m) {
         return vec3<f32>(0.0);
     }
     if is_pbr(m) {
-        return pbr_eval(pbr_lobes(m, dot(wo, n), front_face), to_local(wo, n), to_local(wi, n));
+        let lobes = pbr_lobes(m, dot(wo, n), dot(wo, coat_n), front_face);
+        return pbr_eval(lobes, to_local(wo, n), to_local(wi, n), to_local(wo, coat_n), to_local(wi, coat_n));
     }
     if is_metal(m) {
         return conductor_eval(m.albedo, m.alpha, to_local(wo, n), to_local(wi, n));
@@ -40,12 +42,13 @@ fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, front_face
 }
 
 // The solid-angle pdf with which bsdf_sample returns wi.
-fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, front_face: bool) -> f32 {
+fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, front_face: bool) -> f32 {
     if is_delta(m) {
         return 0.0;
     }
     if is_pbr(m) {
-        return pbr_pdf(pbr_lobes(m, dot(wo, n), front_face), to_local(wo, n), to_local(wi, n));
+        let lobes = pbr_lobes(m, dot(wo, n), dot(wo, coat_n), front_face);
+        return pbr_pdf(lobes, to_local(wo, n), to_local(wi, n), to_local(wo, coat_n), to_local(wi, coat_n));
     }
     if is_metal(m) {
         return ggx_reflection_pdf(to_local(wo, n), to_local(wi, n), m.alpha);
@@ -53,9 +56,10 @@ fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, front_face:
     return max(dot(wi, n), 0.0) / PI;
 }
 
-// Samples the direction light arrives from, for light leaving towards wo. `n` faces wo;
-// `front_face` says whether that is the outside (for glass and transmission).
-fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: ptr<function, u32>) -> BsdfSample {
+// Samples the direction light arrives from, for light leaving towards wo. `n` and `coat_n`
+// face wo (as for bsdf_eval); `front_face` says whether that is the outside (for glass and
+// transmission).
+fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, front_face: bool, rng: ptr<function, u32>) -> BsdfSample {
     if m.kind == MATERIAL_SPECULAR {
         var out: BsdfSample;
         out.pdf = 0.0;
@@ -69,7 +73,7 @@ fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: 
     }
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
     if is_pbr(m) {
-        return pbr_sample(pbr_lobes(m, dot(wo, n), front_face), wo, n, rng_next(rng), u);
+        return pbr_sample(pbr_lobes(m, dot(wo, n), dot(wo, coat_n), front_face), wo, n, coat_n, rng_next(rng), u);
     }
     if is_metal(m) {
         return conductor_sample(m.albedo, m.alpha, wo, n, u);

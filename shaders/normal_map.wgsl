@@ -10,9 +10,9 @@
 // The least cosine a mapped normal keeps with the geometric normal before validation.
 const NORMAL_MAP_MIN_COS: f32 = 1e-3;
 
-// The shading normal at triangle hit `hit` (seen from wo) after material m's normal map (see
-// normal_mapped in src/cpu/normal_map.rs).
-fn normal_mapped(hit: Hit, m: Material, wo: vec3<f32>) -> vec3<f32> {
+// The shading normal at triangle hit `hit` (seen from wo) after the normal map `texture` (the
+// material's, or its coat's) at `scale` (see normal_mapped in src/cpu/normal_map.rs).
+fn normal_mapped(hit: Hit, texture: u32, scale: f32, wo: vec3<f32>) -> vec3<f32> {
     let t = triangle_tangents[hit.index];
     let b = hit.barycentrics;
     let tangent4 = b.x * t.t0 + b.y * t.t1 + b.z * t.t2;
@@ -26,8 +26,8 @@ fn normal_mapped(hit: Hit, m: Material, wo: vec3<f32>) -> vec3<f32> {
     let tangent = raw / len;
     let sign = select(-1.0, 1.0, tangent4.w >= 0.0);
     let bitangent = sign * cross(n, tangent);
-    let c = texture_lookup(m.normal_texture, hit.uv) * 2.0 - vec3<f32>(1.0);
-    let mapped = (c.x * m.normal_scale) * tangent + (c.y * m.normal_scale) * bitangent + c.z * n;
+    let c = texture_lookup(texture, hit.uv) * 2.0 - vec3<f32>(1.0);
+    let mapped = (c.x * scale) * tangent + (c.y * scale) * bitangent + c.z * n;
     let mapped_length = length(mapped);
     if !(mapped_length > 0.0) || mapped_length > F32_MAX {
         return hit.shading_normal;

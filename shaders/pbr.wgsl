@@ -49,8 +49,9 @@ fn multiple_scattering_fresnel(f_average: vec3<f32>, e_average: f32) -> vec3<f32
     return f_average * f_average * e_average / (vec3<f32>(1.0) - f_average * (1.0 - e_average));
 }
 
-// front_face says whether wo is on the outside (which decides eta for transmission).
-fn pbr_lobes(m: Material, mu_o: f32, front_face: bool) -> PbrLobes {
+// front_face says whether wo is on the outside (which decides eta for transmission); mu_o is
+// cos(theta_o) about the base's shading normal, coat_mu_o about the coat's (clearcoat.wgsl).
+fn pbr_lobes(m: Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> PbrLobes {
     var l: PbrLobes;
     l.base = m.albedo;
     l.alpha = max(m.alpha, PBR_MIN_ALPHA);
@@ -97,7 +98,7 @@ fn pbr_lobes(m: Material, mu_o: f32, front_face: bool) -> PbrLobes {
     // against the stack's (which they dim), each within [0.1, 0.45] when present.
     l.coat = no_clearcoat();
     if HAS_CLEARCOAT && m.clearcoat > 0.0 {
-        l.coat = clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, mu_o);
+        l.coat = clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, coat_mu_o);
     }
     l.sheen = no_sheen();
     if HAS_SHEEN && max(m.sheen_color.x, max(m.sheen_color.y, m.sheen_color.z)) > 0.0 {
@@ -113,7 +114,8 @@ fn pbr_lobes(m: Material, mu_o: f32, front_face: bool) -> PbrLobes {
         let sheen_weight = below_coat * l.sheen.albedo_o;
         let all = coat_weight + sheen_weight + l.coat.ms_albedo_o + l.layers_o * total;
         if all > 0.0 {
-            if l.coat.weight > 0.0 {
+            // A coat whose normal wo does not see cannot be sampled (its lobe is black there).
+            if l.coat.weight > 0.0 && coat_mu_o > 0.0 {
                 l.coat_probability = clamp(coat_weight / all, MIN_LOBE_PROBABILITY, MAX_LAYER_PROBABILITY);
             }
             if has_sheen {
@@ -127,8 +129,8 @@ fn pbr_lobes(m: Material, mu_o: f32, front_face: bool) -> PbrLobes {
     return l;
 }
 
-// f * cos(theta_i); wo and wi in the local frame.
-fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+// f * cos(theta_i); wo and wi in the base's local frame, coat_wo and coat_wi in the coat's.
+fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>, coat_wo: vec3<f32>, coat_wi: vec3<f32>) -> vec3<f32> {
     // The transmission lobe's share of the whole.
     let transmissive = (1.0 - l.metallic) * l.transmission;
     if wo.z <= 0.0 || wi.z == 0.0 {
@@ -172,14 +174,15 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
         narrow *= sheen.below;
     }
     if HAS_CLEARCOAT && l.coat.weight > 0.0 {
-        let coat = clearcoat_eval(l.coat, wo, wi);
+        let coat = clearcoat_eval(l.coat, coat_wo, coat_wi);
         return vec3<f32>(coat.f_cos) + coat.below_broad * out + coat.below_narrow * narrow;
     }
     return out + narrow;
 }
 
-// The mixture pdf of pbr_sample; wo and wi in the local frame.
-fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+// The mixture pdf of pbr_sample; wo and wi in the base's local frame, coat_wo and coat_wi in
+// the coat's.
+fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>, coat_wo: vec3<f32>, coat_wi: vec3<f32>) -> f32 {
     if wo.z <= 0.0 {
         return 0.0;
     }
@@ -195,7 +198,7 @@ fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
         pdf += p_specular * ggx_reflection_pdf(wo, wi, l.alpha)
             + (1.0 - p_specular - p_transmission - p_coat - p_sheen) * (wi.z / PI);
         if HAS_CLEARCOAT && p_coat > 0.0 {
-            pdf += p_coat * ggx_reflection_pdf(wo, wi, l.coat.alpha);
+            pdf += p_coat * ggx_reflection_pdf(coat_wo, coat_wi, l.coat.alpha);
         }
         if HAS_SHEEN {
             pdf += p_sheen * UNIFORM_HEMISPHERE_PDF;
@@ -204,11 +207,13 @@ fn pbr_pdf(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     return pdf;
 }
 
-// `choice` picks the lobe, u the direction; n faces wo.
-fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32>) -> BsdfSample {
+// `choice` picks the lobe, u the direction; n (the base's shading normal) and coat_n (the
+// coat's) face wo.
+fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, choice: f32, u: vec2<f32>) -> BsdfSample {
     var out: BsdfSample;
     out.is_delta = false;
     let wo_l = to_local(wo, n);
+    let coat_wo = to_local(wo, coat_n);
     var wi_l: vec3<f32>;
     let p_transmission = l.transmission_probability;
     if HAS_TRANSMISSION && choice < p_transmission {
@@ -229,9 +234,11 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32
         wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
         out.dir = normalize(from_local(wi_l, n));
     } else if HAS_CLEARCOAT && choice < p_transmission + l.specular_probability + l.coat_probability {
-        let h = sample_ggx_visible_normal(wo_l, l.coat.alpha, u);
-        wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
-        out.dir = normalize(from_local(wi_l, n));
+        // The coat's lobe about its own normal.
+        let h = sample_ggx_visible_normal(coat_wo, l.coat.alpha, u);
+        let coat_wi = 2.0 * dot(coat_wo, h) * h - coat_wo;
+        out.dir = normalize(from_local(coat_wi, coat_n));
+        wi_l = to_local(out.dir, n);
     } else if HAS_SHEEN
         && choice < p_transmission + l.specular_probability + l.coat_probability + l.sheen_probability {
         wi_l = sample_uniform_hemisphere(u);
@@ -240,12 +247,13 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, choice: f32, u: vec2<f32
         out.dir = sample_cosine_hemisphere(n, u);
         wi_l = to_local(out.dir, n);
     }
-    out.pdf = pbr_pdf(l, wo_l, wi_l);
+    let coat_wi = to_local(out.dir, coat_n);
+    out.pdf = pbr_pdf(l, wo_l, wi_l, coat_wo, coat_wi);
     out.weight = vec3<f32>(0.0);
     // A reflection below the surface is absorbed: below, f / pdf counts only the transmission
     // lobe's refractions, whose density alone pbr_pdf gives there.
     if out.pdf > 0.0 && wi_l.z > 0.0 {
-        out.weight = pbr_eval(l, wo_l, wi_l) / out.pdf;
+        out.weight = pbr_eval(l, wo_l, wi_l, coat_wo, coat_wi) / out.pdf;
     }
     return out;
 }

@@ -73,8 +73,16 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         return true;
     }
     let m = vertex_colored(material_at(materials[hit.material], hit.uv), hit);
-    if HAS_TEXTURES && m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
-        hit.shading_normal = normal_mapped(hit, m, -ray.dir);
+    // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
+    // else the unmapped one; the base's normal map does not reach it.
+    var coat_normal = hit.shading_normal;
+    if HAS_TEXTURES && hit.primitive == PRIMITIVE_TRIANGLE {
+        if HAS_CLEARCOAT && m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
+            coat_normal = normal_mapped(hit, m.clearcoat_normal_texture, m.clearcoat_normal_scale, -ray.dir);
+        }
+        if m.normal_texture != NO_TEXTURE {
+            hit.shading_normal = normal_mapped(hit, m.normal_texture, m.normal_scale, -ray.dir);
+        }
     }
     if aovs_on() {
         (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
@@ -105,7 +113,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
         let light = sample_light(p, origin, &light_rng);
         if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, hit.front_face);
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
             if any(f_cos > vec3<f32>(0.0)) {
                 segments += 1u;
                 if HAS_ALPHA {
@@ -114,7 +122,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
                     alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
                 }
                 if light_visible(Ray(origin, light.dir), light) {
-                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, hit.front_face);
+                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
                     let weight = nee_weight(light, pdf);
                     let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
                     (*path).radiance += firefly_clamp(contribution, bounce + 1u);
@@ -123,7 +131,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         }
     }
     var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
-    let s = bsdf_sample(m, wo, hit.shading_normal, hit.front_face, &bsdf_rng);
+    let s = bsdf_sample(m, wo, hit.shading_normal, coat_normal, hit.front_face, &bsdf_rng);
     var throughput = (*path).throughput * s.weight;
     if all(throughput == vec3<f32>(0.0)) || crosses_shading_side(s.dir, hit) {
         return true;

@@ -80,6 +80,9 @@ const MATERIAL_SPECULAR: u32 = 1u;
 const MATERIAL_METAL: u32 = 2u;
 const MATERIAL_DIELECTRIC: u32 = 3u;
 const MATERIAL_PBR: u32 = 4u;
+// KHR_materials_unlit: reflects nothing, emits its emission (the base colour) times the vertex
+// colour (vertex_color.wgsl).
+const MATERIAL_UNLIT: u32 = 5u;
 
 // Material.alpha_mode: glTF's OPAQUE, MASK and BLEND.
 const ALPHA_OPAQUE: u32 = 0u;

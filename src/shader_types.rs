@@ -95,6 +95,9 @@ pub const MATERIAL_METAL: u32 = 2;
 pub const MATERIAL_DIELECTRIC: u32 = 3;
 /// glTF's metallic-roughness material (`src/cpu/pbr.rs`).
 pub const MATERIAL_PBR: u32 = 4;
+/// KHR_materials_unlit: reflects nothing, emits its emission (the base colour) times the
+/// vertex colour (`src/cpu/vertex_color.rs`).
+pub const MATERIAL_UNLIT: u32 = 5;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

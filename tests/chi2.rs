@@ -602,7 +602,7 @@ fn cpu_metal_sampling() {
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 41 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
+                let s = glint::cpu::material::bsdf_sample(&m, wo, n, n, true, &mut r);
                 [s.dir.x, s.dir.y, s.dir.z, s.weight.x]
             })
             .collect();
@@ -719,7 +719,7 @@ fn cpu_dielectric_choice() {
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 81 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&glass(front), wo, n, front, &mut r);
+                let s = glint::cpu::material::bsdf_sample(&glass(front), wo, n, n, front, &mut r);
                 [s.dir.x, s.dir.y, s.dir.z, s.weight.x]
             })
             .collect();
@@ -764,7 +764,7 @@ fn total_internal_reflection_always_reflects() {
     let (n, wo) = dielectric_geometry(60.0);
     for i in 0..100_000 {
         let mut r = cpu_draws(i, SEED);
-        let s = glint::cpu::material::bsdf_sample(&glass(false), wo, n, false, &mut r);
+        let s = glint::cpu::material::bsdf_sample(&glass(false), wo, n, n, false, &mut r);
         assert!(s.dir.dot(n) > 0.0, "refracted beyond the critical angle");
         assert_eq!(s.weight, Vec3::ONE);
     }
@@ -1058,12 +1058,13 @@ fn cpu_pbr_sampling() {
                 specular_color: [1.0; 3],
                 ..Default::default()
             };
-            let p = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n), true).specular_probability() as f64;
+            let p = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n), wo.dot(n), true)
+                .specular_probability() as f64;
             let dirs: Vec<Vec3> = (0..SAMPLES)
                 .map(|i| {
                     let mut r = cpu_draws(i, SEED + 97 + k as u32);
-                    let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
-                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, true);
+                    let s = glint::cpu::material::bsdf_sample(&m, wo, n, n, true, &mut r);
+                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, n, true);
                     let above = s.dir.dot(n) > 0.0;
                     assert_eq!(
                         s.weight == Vec3::ZERO,
@@ -1297,7 +1298,7 @@ fn check_pbr_transmission_samples(
     samples: &[(Vec3, bool)],
 ) {
     let (n, wo) = pbr_transmission_geometry();
-    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), entering);
+    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), wo.dot(n), entering);
     let p_s = lobes.specular_probability() as f64;
     let p_t = lobes.transmission_probability() as f64;
     if m.transmission == 1.0 {
@@ -1339,7 +1340,7 @@ fn cpu_pbr_transmission_sampling() {
         let samples: Vec<(Vec3, bool)> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 151 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&m, wo, n, entering, &mut r);
+                let s = glint::cpu::material::bsdf_sample(&m, wo, n, n, entering, &mut r);
                 let kept = s.weight != Vec3::ZERO;
                 if kept {
                     // Refraction is marked delta (light sampling cannot reach it).
@@ -1405,12 +1406,18 @@ fn pbr_layered(
     }
 }
 
-/// The layered pbr sampler: a mixture of the base's visible-normal GGX lobe, the coat's, a
-/// uniform hemisphere for the sheen and the cosine lobe, with the probabilities `pbr_lobes`
-/// reports; the GGX densities are the independent reference above.
-fn check_pbr_layer_samples(name: &str, m: &glint::shader_types::Material, dirs: &[Vec3]) {
+/// The layered pbr sampler: a mixture of the base's visible-normal GGX lobe, the coat's (about
+/// the coat's own normal `coat_n`), a uniform hemisphere for the sheen and the cosine lobe,
+/// with the probabilities `pbr_lobes` reports; the GGX densities are the independent reference
+/// above.
+fn check_pbr_layer_samples(
+    name: &str,
+    m: &glint::shader_types::Material,
+    coat_n: Vec3,
+    dirs: &[Vec3],
+) {
     let (n, wo) = pbr_transmission_geometry();
-    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), true);
+    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), wo.dot(coat_n), true);
     let p_s = lobes.specular_probability() as f64;
     let p_c = lobes.coat_probability() as f64;
     let p_h = lobes.sheen_probability() as f64;
@@ -1430,7 +1437,7 @@ fn check_pbr_layer_samples(name: &str, m: &glint::shader_types::Material, dirs: 
         let coat_alpha = (m.clearcoat_alpha as f64).max(1e-3);
         // The GGX lobes' reflections below the surface are drawn (and absorbed) too.
         let ggx = p_s * reference_ggx_pdf(wo, d, n, m.alpha as f64)
-            + p_c * reference_ggx_pdf(wo, d, n, coat_alpha);
+            + p_c * reference_ggx_pdf(wo, d, coat_n.as_dvec3(), coat_alpha);
         let cos = d.dot(n);
         if cos <= 0.0 {
             return ggx;
@@ -1440,31 +1447,50 @@ fn check_pbr_layer_samples(name: &str, m: &glint::shader_types::Material, dirs: 
     assert_fits(name, &directions_integrated(dirs, n, pdf, 20, 40, 48));
 }
 
+/// The coat's own shading normal of the tilted-coat tests (KHR_materials_clearcoat's
+/// clearcoatNormalTexture): the base's normal turned 35° sideways from the plane of n and wo,
+/// so wo sees both (cos θo 0.5 about n, 0.41 about it) and the coat's reflections fall partly
+/// below the base's surface (drawn there, and absorbed).
+fn tilted_coat_normal() -> Vec3 {
+    let (n, wo) = pbr_transmission_geometry();
+    let side = n.cross(wo).normalize();
+    let angle = 35f32.to_radians();
+    (angle.cos() * n + angle.sin() * side).normalize()
+}
+
 #[test]
 fn cpu_pbr_layer_sampling() {
     let (n, wo) = pbr_transmission_geometry();
-    for (k, (coat, coat_alpha, sheen, sheen_roughness, alpha)) in
-        PBR_LAYER_CASES.into_iter().enumerate()
-    {
-        let m = pbr_layered(coat, coat_alpha, sheen, sheen_roughness, alpha);
-        let dirs: Vec<Vec3> = (0..SAMPLES)
-            .map(|i| {
-                let mut r = cpu_draws(i, SEED + 191 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&m, wo, n, true, &mut r);
-                let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, true);
-                // The coat's α 0.01 lobe turns the direction's f32 rounding between frames
-                // into relative pdf differences near 1e-3.
-                if s.dir.dot(n) > 0.0 {
-                    assert!((s.pdf - pdf).abs() <= 1e-2 * pdf, "pdf {} vs {pdf}", s.pdf);
-                }
-                s.dir
-            })
-            .collect();
-        check_pbr_layer_samples(
-            &format!("cpu pbr, coat {coat} α {coat_alpha}, sheen {sheen} r {sheen_roughness}"),
-            &m,
-            &dirs,
-        );
+    for (coat_n, tilt) in [(n, ""), (tilted_coat_normal(), ", coat normal tilted")] {
+        for (k, (coat, coat_alpha, sheen, sheen_roughness, alpha)) in
+            PBR_LAYER_CASES.into_iter().enumerate()
+        {
+            if coat == 0.0 && !tilt.is_empty() {
+                continue;
+            }
+            let m = pbr_layered(coat, coat_alpha, sheen, sheen_roughness, alpha);
+            let dirs: Vec<Vec3> = (0..SAMPLES)
+                .map(|i| {
+                    let mut r = cpu_draws(i, SEED + 191 + k as u32);
+                    let s = glint::cpu::material::bsdf_sample(&m, wo, n, coat_n, true, &mut r);
+                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, coat_n, true);
+                    // The coat's α 0.01 lobe turns the direction's f32 rounding between frames
+                    // into relative pdf differences near 1e-3.
+                    if s.dir.dot(n) > 0.0 {
+                        assert!((s.pdf - pdf).abs() <= 1e-2 * pdf, "pdf {} vs {pdf}", s.pdf);
+                    }
+                    s.dir
+                })
+                .collect();
+            check_pbr_layer_samples(
+                &format!(
+                    "cpu pbr, coat {coat} α {coat_alpha}, sheen {sheen} r {sheen_roughness}{tilt}"
+                ),
+                &m,
+                coat_n,
+                &dirs,
+            );
+        }
     }
 }
 
@@ -1473,29 +1499,38 @@ fn cpu_pbr_layer_sampling() {
 fn gpu_pbr_layer_sampling() {
     let Some(ctx) = common::gpu() else { return };
     let (n, wo) = pbr_transmission_geometry();
-    for (k, (coat, coat_alpha, sheen, sheen_roughness, alpha)) in
-        PBR_LAYER_CASES.into_iter().enumerate()
-    {
-        let m = pbr_layered(coat, coat_alpha, sheen, sheen_roughness, alpha);
-        let params = ProbeParams {
-            wo: wo.into(),
-            alpha,
-            ior: GLASS_IOR,
-            front_face: 1,
-            clearcoat: coat,
-            clearcoat_alpha: coat_alpha,
-            sheen,
-            sheen_roughness,
-            ..probe(n, SAMPLES, SEED + 211 + k as u32)
-        };
-        let dirs: Vec<Vec3> = run_probe(ctx, "probe_pbr", params, &empty_scene())
-            .iter()
-            .map(|s| Vec3::new(s[0], s[1], s[2]))
-            .collect();
-        check_pbr_layer_samples(
-            &format!("gpu pbr, coat {coat} α {coat_alpha}, sheen {sheen} r {sheen_roughness}"),
-            &m,
-            &dirs,
-        );
+    for (coat_n, tilt) in [(n, ""), (tilted_coat_normal(), ", coat normal tilted")] {
+        for (k, (coat, coat_alpha, sheen, sheen_roughness, alpha)) in
+            PBR_LAYER_CASES.into_iter().enumerate()
+        {
+            if coat == 0.0 && !tilt.is_empty() {
+                continue;
+            }
+            let m = pbr_layered(coat, coat_alpha, sheen, sheen_roughness, alpha);
+            let params = ProbeParams {
+                wo: wo.into(),
+                alpha,
+                ior: GLASS_IOR,
+                front_face: 1,
+                clearcoat: coat,
+                clearcoat_alpha: coat_alpha,
+                sheen,
+                sheen_roughness,
+                coat_normal: coat_n.into(),
+                ..probe(n, SAMPLES, SEED + 211 + k as u32)
+            };
+            let dirs: Vec<Vec3> = run_probe(ctx, "probe_pbr", params, &empty_scene())
+                .iter()
+                .map(|s| Vec3::new(s[0], s[1], s[2]))
+                .collect();
+            check_pbr_layer_samples(
+                &format!(
+                    "gpu pbr, coat {coat} α {coat_alpha}, sheen {sheen} r {sheen_roughness}{tilt}"
+                ),
+                &m,
+                coat_n,
+                &dirs,
+            );
+        }
     }
 }

@@ -890,7 +890,7 @@ fn unlit_materials_emit_their_base_colour() {
         "extensions": {"KHR_materials_unlit": {}}
     });
     let m = loaded_material(material.clone());
-    assert_eq!(m.kind, glint::scene::MaterialKind::Diffuse);
+    assert_eq!(m.kind, glint::scene::MaterialKind::Unlit);
     assert_eq!(m.color, glam::Vec3::ZERO);
     assert_eq!(m.emitted_radiance, glam::Vec3::new(0.2, 0.4, 0.6));
     assert_eq!(m.emission_texture, None);

@@ -408,8 +408,9 @@ fn the_damaged_helmet_renders_on_the_gpu_as_on_the_cpu() {
 }
 
 /// Khronos' ClearCoatTest (KHR_materials_clearcoat: spheres without a coat, with one, with a
-/// partial, rough or normal-mapped one) loads without the unsupported-extension warning and
-/// renders a finite, lit image; its coated materials carry their coat into the kernel.
+/// partial, rough or normal-mapped one) loads without the unsupported-extension warning (nor
+/// one about the coat's normal map, which is rendered) and renders a finite, lit image; its
+/// coated materials carry their coat into the kernel, the last row's its own normal map.
 #[test]
 fn the_clear_coat_test_loads_and_renders() {
     let Some(path) = sample("ClearCoat-glTF/ClearCoatTest.gltf") else {
@@ -427,6 +428,7 @@ fn the_clear_coat_test_loads_and_renders() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(0), "{stderr}");
     assert!(!stderr.contains("reads in part or not at all"), "{stderr}");
+    assert!(!stderr.contains("clearcoatNormalTexture"), "{stderr}");
     let image = image::open(&out).unwrap().to_rgb8();
     let mean = image.pixels().map(|p| p.0[1] as f64).sum::<f64>() / image.len() as f64 * 3.0;
     assert!(mean > 10.0, "the render is black: mean {mean}");
@@ -440,4 +442,13 @@ fn the_clear_coat_test_loads_and_renders() {
         .filter(|m| m.clearcoat == 1.0)
         .count();
     assert_eq!(coated, 6, "the six *_Coated materials");
+    let coat_mapped = scene
+        .kernel_scene()
+        .materials
+        .iter()
+        .filter(|m| {
+            m.clearcoat > 0.0 && m.clearcoat_normal_texture != glint::shader_types::NO_TEXTURE
+        })
+        .count();
+    assert!(coat_mapped >= 1, "no material has the coat's normal map");
 }

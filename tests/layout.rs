@@ -282,6 +282,7 @@ fn material_kind_constants_match() {
         ("MATERIAL_METAL", t::MATERIAL_METAL),
         ("MATERIAL_DIELECTRIC", t::MATERIAL_DIELECTRIC),
         ("MATERIAL_PBR", t::MATERIAL_PBR),
+        ("MATERIAL_UNLIT", t::MATERIAL_UNLIT),
         ("ALPHA_OPAQUE", t::ALPHA_OPAQUE),
         ("ALPHA_MASK", t::ALPHA_MASK),
         ("ALPHA_BLEND", t::ALPHA_BLEND),

@@ -147,7 +147,8 @@ fn cpu_normals(scene: &glint::scene::KernelScene) -> Vec<[f32; 4]> {
             hit.shading_normal = normal_mapped(
                 &refs.textures(),
                 &hit,
-                &m,
+                m.normal_texture,
+                m.normal_scale,
                 &scene.triangle_tangents[hit.index as usize],
                 -ray.dir,
             );

@@ -441,12 +441,13 @@ fn sample_weights_are_eval_over_pdf() {
         for i in 0..20_000u32 {
             let mut r = Rng::new(i, 4, 5, 6);
             let wo = random_direction(&mut r, 1.0);
-            let s = glint::cpu::material::bsdf_sample(&m, wo, Vec3::Z, front, &mut r);
+            let s = glint::cpu::material::bsdf_sample(&m, wo, Vec3::Z, Vec3::Z, front, &mut r);
             if s.weight == Vec3::ZERO {
                 continue;
             }
-            let lobes = pbr_lobes(&m, wo.z, front);
-            let ratio = pbr_eval(&lobes, wo, s.dir) / pbr_pdf(&lobes, wo, s.dir);
+            let lobes = pbr_lobes(&m, wo.z, wo.z, front);
+            let ratio =
+                pbr_eval(&lobes, wo, s.dir, wo, s.dir) / pbr_pdf(&lobes, wo, s.dir, wo, s.dir);
             assert!(
                 (s.weight - ratio).abs().max_element() <= 5e-3 * ratio.max_element(),
                 "transmission {transmission}, wo {wo}, wi {}: weight {} vs {ratio}",

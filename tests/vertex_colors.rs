@@ -380,3 +380,110 @@ fn ply_vertex_colors_are_read_srgb_decoded() {
         ])
     );
 }
+
+/// The square with its own glTF material, KHR_materials_unlit of base colour (0.5, 1, 1), as
+/// `square_scene` writes it otherwise (float RGB colours).
+fn unlit_square(dir: &Path) {
+    write_square(dir, &COLORS, FLOAT_RGB, |_| {});
+    let path = dir.join("square.gltf");
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    json["materials"] = serde_json::json!([{
+        "pbrMetallicRoughness": {"baseColorFactor": [0.5, 1.0, 1.0, 1.0]},
+        "extensions": {"KHR_materials_unlit": {}}
+    }]);
+    json["extensionsUsed"] = serde_json::json!(["KHR_materials_unlit"]);
+    json["meshes"][0]["primitives"][0]["material"] = 0.into();
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+}
+
+/// KHR_materials_unlit shows the base colour, and COLOR_0 multiplies the base colour: an
+/// unlit square's pixels are the base colour times the vertex colour (camera rays only, on a
+/// black background), on every device.
+#[test]
+fn vertex_colors_multiply_an_unlit_materials_colour_on_every_device() {
+    let dir = tempfile::tempdir().unwrap();
+    unlit_square(dir.path());
+    let text = scene_text("", 0, 4)
+        .replace(
+            "background = [1.0, 1.0, 1.0]",
+            "background = [0.0, 0.0, 0.0]",
+        )
+        .replace("[materials.square]\n", "")
+        .replace("material = \"square\"\n", "");
+    let scene = load(dir.path(), &text)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .kernel_scene();
+    let base = Vec3::new(0.5, 1.0, 1.0);
+    for (device, image) in render_everywhere(&scene, 4) {
+        let a = pixel(&image, IN_A);
+        let want_a = base * Vec3::new(0.8, 0.4, 0.2);
+        assert!(
+            (a - want_a).abs().max_element() < 1e-4,
+            "{device}: A's pixel is {a}, want {want_a}"
+        );
+        let b = pixel(&image, IN_B);
+        let want_b = base * color_in_b(on_square(IN_B)).truncate();
+        assert!(
+            (b - want_b).abs().max_element() < 0.02,
+            "{device}: B's pixel is {b}, want about {want_b}"
+        );
+    }
+}
+
+/// The unlit square lights a white floor in front of it as a lamp of its colours: light
+/// sampling (which looks the emission up at the sampled point, the vertex colour included)
+/// and BSDF sampling alone (which finds it at hits) agree, within 5 standard errors of the
+/// difference of the image means (from the variance images), on the CPU and the GPU.
+#[test]
+fn an_unlit_vertex_colored_lamp_lights_the_same_with_light_sampling() {
+    let dir = tempfile::tempdir().unwrap();
+    unlit_square(dir.path());
+    let text = "[camera]\neye = [0.0, 3.0, 6.0]\ntarget = [0.0, -1.0, 1.5]\n\
+                up = [0.0, 1.0, 0.0]\nvfov = 30.0\n\n[render]\nwidth = 24\nheight = 24\n\
+                spp = 64\nmax_bounces = 1\n\n[materials.floor]\ntype = \"diffuse\"\n\
+                color = [1.0, 1.0, 1.0]\n\n[[quads]]\ncorner = [-3.0, -1.0, 4.0]\n\
+                u = [6.0, 0.0, 0.0]\nv = [0.0, 0.0, -4.0]\nmaterial = \"floor\"\n\n\
+                [[meshes]]\nfile = \"square.gltf\"\n";
+    let scene = load(dir.path(), text).unwrap_or_else(|e| panic!("{e}"));
+    let spp = 64;
+    let on = common::with_light_sampling(&scene, true, 5);
+    let off = common::with_light_sampling(&scene, false, 5);
+    assert!(!on.emitters.is_empty(), "the unlit square is an emitter");
+    let mean = |r: &mut dyn Renderer| {
+        let (image, variance) = common::render_with_variance(r, spp);
+        let n = (image.pixels.len() * 3) as f64;
+        let m = image
+            .pixels
+            .iter()
+            .flatten()
+            .map(|&v| v as f64)
+            .sum::<f64>()
+            / n;
+        let v = variance
+            .pixels
+            .iter()
+            .flatten()
+            .map(|&v| v as f64)
+            .sum::<f64>()
+            / (n * n);
+        (m, v)
+    };
+    // The CPU and, where there is one, the GPU.
+    for ((device, mut with), (_, mut without)) in common::renderers(&on)
+        .into_iter()
+        .zip(common::renderers(&off))
+    {
+        let (a, va) = mean(with.as_mut());
+        let (b, vb) = mean(without.as_mut());
+        let z = (a - b) / (va + vb).sqrt();
+        eprintln!("{device}: light sampling on {a:.5}, off {b:.5}, z {z:.2}");
+        assert!(a > 0.01, "{device}: the floor is lit ({a})");
+        assert!(
+            z.abs() < 5.0,
+            "{device}: on {a} ± {}, off {b} ± {}",
+            va.sqrt(),
+            vb.sqrt()
+        );
+    }
+}

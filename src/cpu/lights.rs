@@ -15,6 +15,7 @@ use super::trace::SceneRefs;
 use super::triangle::{
     triangle_normal, triangle_plane_distance, triangle_point, triangle_sample_barycentrics,
 };
+use super::vertex_color::vertex_colored_emission;
 use super::Ray;
 use crate::shader_types::{
     Sphere, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
@@ -136,12 +137,13 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
             e.probability * area_to_solid_angle(t, triangle_normal(tri).dot(out.dir), tri.area);
         // The emission where the sample lies (glTF's emissive texture).
         let m = &scene.materials[tri.material as usize];
-        out.radiance = if m.emission_texture != NO_TEXTURE {
+        let emission = if m.emission_texture != NO_TEXTURE {
             let uv = triangle_uv(scene.triangle_uvs, scene.triangle_uvs1, e.index, b);
             emission_at(&scene.textures(), m, uv)
         } else {
             Vec3::from(m.emission)
         };
+        out.radiance = vertex_colored_emission(scene.triangle_colors, m, e.index, b, emission);
         return out;
     }
     if e.primitive == PRIMITIVE_QUAD {

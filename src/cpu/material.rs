@@ -24,15 +24,29 @@ pub fn is_delta(m: &Material) -> bool {
 
 /// f · cos θi for light arriving from wi and leaving towards wo (n faces wo; `front_face` says
 /// whether that is the outside). Zero for delta lobes and for wi below the surface (light
-/// sampling's shadow rays do not pass through surfaces).
-pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, front_face: bool) -> Vec3 {
+/// sampling's shadow rays do not pass through surfaces). `coat_n`, facing wo too, is the pbr
+/// coat's own shading normal (KHR_materials_clearcoat's: n itself where nothing tilts it).
+pub fn bsdf_eval(
+    m: &Material,
+    wo: Vec3,
+    wi: Vec3,
+    n: Vec3,
+    coat_n: Vec3,
+    front_face: bool,
+) -> Vec3 {
     let cos_i = wi.dot(n);
     if cos_i <= 0.0 || is_delta(m) {
         return Vec3::ZERO;
     }
     if m.kind == MATERIAL_PBR {
-        let lobes = pbr_lobes(m, wo.dot(n), front_face);
-        return pbr_eval(&lobes, to_local(wo, n), to_local(wi, n));
+        let lobes = pbr_lobes(m, wo.dot(n), wo.dot(coat_n), front_face);
+        return pbr_eval(
+            &lobes,
+            to_local(wo, n),
+            to_local(wi, n),
+            to_local(wo, coat_n),
+            to_local(wi, coat_n),
+        );
     }
     if m.kind == MATERIAL_METAL {
         return conductor_eval(
@@ -46,13 +60,19 @@ pub fn bsdf_eval(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, front_face: bool) ->
 }
 
 /// The solid-angle pdf with which [`bsdf_sample`] returns wi.
-pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, front_face: bool) -> f32 {
+pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, coat_n: Vec3, front_face: bool) -> f32 {
     if is_delta(m) {
         return 0.0;
     }
     if m.kind == MATERIAL_PBR {
-        let lobes = pbr_lobes(m, wo.dot(n), front_face);
-        return pbr_pdf(&lobes, to_local(wo, n), to_local(wi, n));
+        let lobes = pbr_lobes(m, wo.dot(n), wo.dot(coat_n), front_face);
+        return pbr_pdf(
+            &lobes,
+            to_local(wo, n),
+            to_local(wi, n),
+            to_local(wo, coat_n),
+            to_local(wi, coat_n),
+        );
     }
     if m.kind == MATERIAL_METAL {
         return ggx_reflection_pdf(to_local(wo, n), to_local(wi, n), m.alpha);
@@ -60,9 +80,17 @@ pub fn bsdf_pdf(m: &Material, wo: Vec3, wi: Vec3, n: Vec3, front_face: bool) -> 
     wi.dot(n).max(0.0) / PI
 }
 
-/// Samples the direction light arrives from, for light leaving towards wo. `n` faces wo;
-/// `front_face` says whether that is the outside (for glass and transmission).
-pub fn bsdf_sample(m: &Material, wo: Vec3, n: Vec3, front_face: bool, rng: &mut Rng) -> BsdfSample {
+/// Samples the direction light arrives from, for light leaving towards wo. `n` and `coat_n`
+/// face wo (as for [`bsdf_eval`]); `front_face` says whether that is the outside (for glass
+/// and transmission).
+pub fn bsdf_sample(
+    m: &Material,
+    wo: Vec3,
+    n: Vec3,
+    coat_n: Vec3,
+    front_face: bool,
+    rng: &mut Rng,
+) -> BsdfSample {
     if m.kind == MATERIAL_SPECULAR {
         return BsdfSample {
             dir: reflect(-wo, n).normalize(),
@@ -76,8 +104,8 @@ pub fn bsdf_sample(m: &Material, wo: Vec3, n: Vec3, front_face: bool, rng: &mut 
     }
     let u = (rng.next_f32(), rng.next_f32());
     if m.kind == MATERIAL_PBR {
-        let lobes = pbr_lobes(m, wo.dot(n), front_face);
-        return pbr_sample(&lobes, wo, n, rng.next_f32(), u);
+        let lobes = pbr_lobes(m, wo.dot(n), wo.dot(coat_n), front_face);
+        return pbr_sample(&lobes, wo, n, coat_n, rng.next_f32(), u);
     }
     if m.kind == MATERIAL_METAL {
         return conductor_sample(Vec3::from(m.albedo), m.alpha, wo, n, u);

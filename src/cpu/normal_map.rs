@@ -7,21 +7,23 @@
 use super::intersect::Hit;
 use super::shading_normal::valid_shading_normal;
 use super::texture::{texture_lookup, Textures};
-use crate::shader_types::{Material, TriangleTangents};
+use crate::shader_types::TriangleTangents;
 use glam::{Vec3, Vec4};
 
 /// The least cosine a mapped normal keeps with the geometric normal before validation.
 const MIN_COS: f32 = 1e-3;
 
-/// The shading normal at triangle hit `hit` (seen from `wo`) after material `m`'s normal map,
-/// with the triangle's vertex tangents `t`. glTF's rule: the texel, mapped from [0, 1] to
+/// The shading normal at triangle hit `hit` (seen from `wo`) after the normal map `texture`
+/// (the material's normalTexture, or its coat's clearcoatNormalTexture) at `scale`, with the
+/// triangle's vertex tangents `t`. glTF's rule: the texel, mapped from [0, 1] to
 /// [−1, 1], x and y scaled by the map's scale, is a direction in (tangent, bitangent,
 /// normal), the bitangent being sign · normal × tangent. The frame is built on the outward
 /// side (the side the tangents were made for) and the result turned to the side seen.
 pub fn normal_mapped(
     textures: &Textures,
     hit: &Hit,
-    m: &Material,
+    texture: u32,
+    scale: f32,
     t: &TriangleTangents,
     wo: Vec3,
 ) -> Vec3 {
@@ -39,8 +41,8 @@ pub fn normal_mapped(
     let tangent = raw / length;
     let sign = if tangent4.w >= 0.0 { 1.0 } else { -1.0 };
     let bitangent = sign * n.cross(tangent);
-    let c = texture_lookup(textures, m.normal_texture, hit.uv) * 2.0 - Vec3::ONE;
-    let mapped = (c.x * m.normal_scale) * tangent + (c.y * m.normal_scale) * bitangent + c.z * n;
+    let c = texture_lookup(textures, texture, hit.uv) * 2.0 - Vec3::ONE;
+    let mapped = (c.x * scale) * tangent + (c.y * scale) * bitangent + c.z * n;
     let mapped_length = mapped.length();
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
     if !(mapped_length > 0.0) || !mapped_length.is_finite() {

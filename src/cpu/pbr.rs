@@ -128,8 +128,9 @@ impl PbrLobes {
     }
 }
 
-/// `front_face` says whether wo is on the outside (which decides η for transmission).
-pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
+/// `front_face` says whether wo is on the outside (which decides η for transmission); `mu_o`
+/// is cos θo about the base's shading normal, `coat_mu_o` about the coat's (clearcoat.rs).
+pub fn pbr_lobes(m: &Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> PbrLobes {
     let base = Vec3::from(m.albedo);
     let alpha = m.alpha.max(PBR_MIN_ALPHA);
     let r = (m.ior - 1.0) / (m.ior + 1.0);
@@ -178,7 +179,7 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
     // against the stack's (which they dim), each within [0.1, 0.45] when present.
     // Only materials with a coat or a sheen read their tables.
     let coat = if m.clearcoat > 0.0 {
-        clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, mu_o)
+        clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, coat_mu_o)
     } else {
         NO_CLEARCOAT
     };
@@ -202,7 +203,8 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
                 0.0
             }
         };
-        coat_probability = share(coat_weight, coat.weight > 0.0);
+        // A coat whose normal wo does not see cannot be sampled (its lobe is black there).
+        coat_probability = share(coat_weight, coat.weight > 0.0 && coat_mu_o > 0.0);
         sheen_probability = share(sheen_weight, sheen.color.max_element() > 0.0);
         let rest = 1.0 - coat_probability - sheen_probability;
         specular_probability *= rest;
@@ -232,8 +234,9 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, front_face: bool) -> PbrLobes {
     }
 }
 
-/// f · cos θi; wo and wi in the local frame.
-pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
+/// f · cos θi; wo and wi in the base's local frame, coat_wo and coat_wi (the same directions)
+/// in the coat's.
+pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3, coat_wo: Vec3, coat_wi: Vec3) -> Vec3 {
     let l = lobes;
     // The transmission lobe's share of the whole.
     let transmissive = (1.0 - l.metallic) * l.transmission;
@@ -297,14 +300,15 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> Vec3 {
         narrow *= below;
     }
     if l.coat.weight > 0.0 {
-        let coat = clearcoat_eval(&l.coat, wo, wi);
+        let coat = clearcoat_eval(&l.coat, coat_wo, coat_wi);
         return Vec3::splat(coat.f_cos) + coat.below_broad * out + coat.below_narrow * narrow;
     }
     out + narrow
 }
 
-/// The mixture pdf of [`pbr_sample`]; wo and wi in the local frame.
-pub fn pbr_pdf(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> f32 {
+/// The mixture pdf of [`pbr_sample`]; wo and wi in the base's local frame, coat_wo and coat_wi
+/// in the coat's.
+pub fn pbr_pdf(lobes: &PbrLobes, wo: Vec3, wi: Vec3, coat_wo: Vec3, coat_wi: Vec3) -> f32 {
     if wo.z <= 0.0 {
         return 0.0;
     }
@@ -318,16 +322,25 @@ pub fn pbr_pdf(lobes: &PbrLobes, wo: Vec3, wi: Vec3) -> f32 {
         pdf += p_specular * ggx_reflection_pdf(wo, wi, lobes.alpha)
             + (1.0 - p_specular - p_transmission - p_coat - p_sheen) * (wi.z / PI);
         if p_coat > 0.0 {
-            pdf += p_coat * ggx_reflection_pdf(wo, wi, lobes.coat.alpha);
+            pdf += p_coat * ggx_reflection_pdf(coat_wo, coat_wi, lobes.coat.alpha);
         }
         pdf += p_sheen * UNIFORM_HEMISPHERE_PDF;
     }
     pdf
 }
 
-/// `choice` picks the lobe, `u` the direction; `n` faces wo.
-pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32)) -> BsdfSample {
+/// `choice` picks the lobe, `u` the direction; `n` (the base's shading normal) and `coat_n`
+/// (the coat's) face wo.
+pub fn pbr_sample(
+    lobes: &PbrLobes,
+    wo: Vec3,
+    n: Vec3,
+    coat_n: Vec3,
+    choice: f32,
+    u: (f32, f32),
+) -> BsdfSample {
     let wo_l = to_local(wo, n);
+    let coat_wo = to_local(wo, coat_n);
     let l = lobes;
     let p_transmission = l.transmission_probability;
     let (dir, wi_l) = if choice < p_transmission {
@@ -351,9 +364,11 @@ pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32
         let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
         (from_local(wi_l, n).normalize(), wi_l)
     } else if choice < p_transmission + lobes.specular_probability + l.coat_probability {
-        let h = sample_ggx_visible_normal(wo_l, l.coat.alpha, u);
-        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
-        (from_local(wi_l, n).normalize(), wi_l)
+        // The coat's lobe about its own normal.
+        let h = sample_ggx_visible_normal(coat_wo, l.coat.alpha, u);
+        let coat_wi = 2.0 * coat_wo.dot(h) * h - coat_wo;
+        let dir = from_local(coat_wi, coat_n).normalize();
+        (dir, to_local(dir, n))
     } else if choice
         < p_transmission + lobes.specular_probability + l.coat_probability + l.sheen_probability
     {
@@ -363,11 +378,12 @@ pub fn pbr_sample(lobes: &PbrLobes, wo: Vec3, n: Vec3, choice: f32, u: (f32, f32
         let dir = sample_cosine_hemisphere(n, u);
         (dir, to_local(dir, n))
     };
-    let pdf = pbr_pdf(lobes, wo_l, wi_l);
+    let coat_wi = to_local(dir, coat_n);
+    let pdf = pbr_pdf(lobes, wo_l, wi_l, coat_wo, coat_wi);
     // A reflection below the surface is absorbed: below, f / pdf counts only the transmission
     // lobe's refractions, whose density alone pbr_pdf gives there.
     let weight = if pdf > 0.0 && wi_l.z > 0.0 {
-        pbr_eval(lobes, wo_l, wi_l) / pdf
+        pbr_eval(lobes, wo_l, wi_l, coat_wo, coat_wi) / pdf
     } else {
         Vec3::ZERO
     };

@@ -239,14 +239,30 @@ pub fn path_step(
         ),
         &hit,
     );
-    if m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
-        hit.shading_normal = normal_mapped(
-            &scene.textures(),
-            &hit,
-            m,
-            &scene.triangle_tangents[hit.index as usize],
-            -ray.dir,
-        );
+    // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
+    // else the unmapped one; the base's normal map does not reach it.
+    let mut coat_normal = hit.shading_normal;
+    if hit.primitive == PRIMITIVE_TRIANGLE {
+        if m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
+            coat_normal = normal_mapped(
+                &scene.textures(),
+                &hit,
+                m.clearcoat_normal_texture,
+                m.clearcoat_normal_scale,
+                &scene.triangle_tangents[hit.index as usize],
+                -ray.dir,
+            );
+        }
+        if m.normal_texture != NO_TEXTURE {
+            hit.shading_normal = normal_mapped(
+                &scene.textures(),
+                &hit,
+                m.normal_texture,
+                m.normal_scale,
+                &scene.triangle_tangents[hit.index as usize],
+                -ray.dir,
+            );
+        }
     }
     if aovs_on(params) {
         aov_record_hit(&mut path.aov, bounce, &hit, m);
@@ -285,7 +301,14 @@ pub fn path_step(
         let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
         let light = sample_light(scene, p, origin, &mut light_rng);
         if light.pdf > 0.0 && !crosses_shading_side(light.dir, &hit) {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, hit.front_face);
+            let f_cos = bsdf_eval(
+                m,
+                wo,
+                light.dir,
+                hit.shading_normal,
+                coat_normal,
+                hit.front_face,
+            );
             if f_cos.cmpgt(Vec3::ZERO).any() {
                 let shadow = Ray {
                     origin,
@@ -303,7 +326,14 @@ pub fn path_step(
                     scene
                 };
                 if light_visible(shadow_scene, &shadow, &light) {
-                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, hit.front_face);
+                    let pdf = bsdf_pdf(
+                        m,
+                        wo,
+                        light.dir,
+                        hit.shading_normal,
+                        coat_normal,
+                        hit.front_face,
+                    );
                     let weight = nee_weight(&light, pdf);
                     let contribution =
                         path.throughput * f_cos * light.radiance * (weight / light.pdf);
@@ -313,7 +343,14 @@ pub fn path_step(
         }
     }
     let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
-    let s = bsdf_sample(m, wo, hit.shading_normal, hit.front_face, &mut bsdf_rng);
+    let s = bsdf_sample(
+        m,
+        wo,
+        hit.shading_normal,
+        coat_normal,
+        hit.front_face,
+        &mut bsdf_rng,
+    );
     let mut throughput = path.throughput * s.weight;
     if throughput == Vec3::ZERO || crosses_shading_side(s.dir, &hit) {
         return true;

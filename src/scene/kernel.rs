@@ -11,8 +11,8 @@ use crate::shader_types::{
     self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleColors,
     TriangleNormals, TriangleTangents, TriangleUvs, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE,
     MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR,
-    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
-    PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    MATERIAL_UNLIT, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -239,6 +239,7 @@ impl Scene {
                 let mut layers = super::PbrLayers::default();
                 let (kind, alpha, ior) = match m.kind {
                     MaterialKind::Diffuse => (MATERIAL_DIFFUSE, 0.0, 1.0),
+                    MaterialKind::Unlit => (MATERIAL_UNLIT, 0.0, 1.0),
                     MaterialKind::Specular => (MATERIAL_SPECULAR, 0.0, 1.0),
                     MaterialKind::Metal { roughness } => {
                         (MATERIAL_METAL, roughness * roughness, 1.0)
@@ -376,7 +377,7 @@ impl Scene {
             } else {
                 Vec::new()
             },
-            triangle_tangents: if self.materials.iter().any(|m| m.normal_texture.is_some()) {
+            triangle_tangents: if self.materials.iter().any(|m| m.has_normal_map()) {
                 self.triangles
                     .iter()
                     .map(|t| {
@@ -466,7 +467,20 @@ impl Scene {
                 ),
                 _ => radiance(t.material).element_sum() as f64 / 3.0,
             };
-            let power = mean * 0.5 * (b - a).cross(c - a).length() as f64;
+            // An unlit triangle's vertex colour multiplies what it emits: its mean over the
+            // triangle (the corners' mean) estimates the product's.
+            let color_mean = match t.colors {
+                Some(colors) if matches!(m.kind, MaterialKind::Unlit) => {
+                    colors
+                        .iter()
+                        .map(|c| c.truncate())
+                        .sum::<Vec3>()
+                        .element_sum() as f64
+                        / 9.0
+                }
+                _ => 1.0,
+            };
+            let power = mean * color_mean * 0.5 * (b - a).cross(c - a).length() as f64;
             if power > 0.0 {
                 powers.push((PRIMITIVE_TRIANGLE, i as u32, power));
             }

@@ -157,6 +157,9 @@ pub struct RenderSettings {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MaterialKind {
     Diffuse,
+    /// KHR_materials_unlit: reflects nothing, emits `emitted_radiance` (the base colour) times
+    /// the colour texture and the vertex colour.
+    Unlit,
     Specular,
     /// GGX microfacet conductor; roughness in [0, 1], GGX alpha = roughness² (unused where
     /// [`Material::roughness_texture`] is set).
@@ -229,6 +232,16 @@ pub struct Material {
     pub normal_texture: Option<(u32, f32)>,
     /// glTF's alphaMode and alpha (`src/cpu/alpha.rs`); on triangles only.
     pub alpha: Alpha,
+}
+
+impl Material {
+    /// Whether the material has a normal map (its own, or its coat's), which needs vertex
+    /// tangents.
+    pub fn has_normal_map(&self) -> bool {
+        self.normal_texture.is_some()
+            || matches!(&self.kind, MaterialKind::Pbr { layers, .. }
+                if layers.clearcoat_normal_texture.is_some())
+    }
 }
 
 /// How a material's alpha (its opacity times its colour texture's alpha) is used: glTF's

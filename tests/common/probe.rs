@@ -31,6 +31,9 @@ pub struct ProbeParams {
     pub sheen: f32,
     pub sheen_roughness: f32,
     pub _pad: [u32; 2],
+    /// The coat's own shading normal (probe_pbr); zero: the base's, `normal`.
+    pub coat_normal: [f32; 3],
+    pub _pad2: u32,
 }
 
 pub const PROBE_SOURCE: &str = include_str!("../shaders/probe.wgsl");

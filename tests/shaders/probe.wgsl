@@ -20,6 +20,8 @@ struct ProbeParams {
     clearcoat_alpha: f32,
     sheen: f32,
     sheen_roughness: f32,
+    // The coat's own shading normal (probe_pbr); zero: the base's, `normal`.
+    coat_normal: vec3<f32>,
 }
 
 @group(0) @binding(10) var<uniform> probe: ProbeParams;
@@ -73,7 +75,7 @@ fn probe_metal(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var rng = rng_init(id.x, 0u, 1u, probe.seed);
-    let s = bsdf_sample(probe_material(MATERIAL_METAL), probe.wo, probe.normal, true, &rng);
+    let s = bsdf_sample(probe_material(MATERIAL_METAL), probe.wo, probe.normal, probe.normal, true, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
 
@@ -92,7 +94,8 @@ fn probe_pbr(@builtin(global_invocation_id) id: vec3<u32>) {
     m.clearcoat_alpha = probe.clearcoat_alpha;
     m.sheen_color = vec3<f32>(probe.sheen);
     m.sheen_roughness = probe.sheen_roughness;
-    let s = bsdf_sample(m, probe.wo, probe.normal, probe.front_face != 0u, &rng);
+    let coat_normal = select(probe.normal, probe.coat_normal, dot(probe.coat_normal, probe.coat_normal) > 0.0);
+    let s = bsdf_sample(m, probe.wo, probe.normal, coat_normal, probe.front_face != 0u, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
 
@@ -102,7 +105,7 @@ fn probe_dielectric(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     var rng = rng_init(id.x, 0u, 1u, probe.seed);
-    let s = bsdf_sample(probe_material(MATERIAL_DIELECTRIC), probe.wo, probe.normal, probe.front_face != 0u, &rng);
+    let s = bsdf_sample(probe_material(MATERIAL_DIELECTRIC), probe.wo, probe.normal, probe.normal, probe.front_face != 0u, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
 
@@ -238,7 +241,7 @@ fn probe_normal_map(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let m = material_at(materials[hit.material], hit.uv);
     if m.normal_texture != NO_TEXTURE && hit.primitive == PRIMITIVE_TRIANGLE {
-        hit.shading_normal = normal_mapped(hit, m, -ray.dir);
+        hit.shading_normal = normal_mapped(hit, m.normal_texture, m.normal_scale, -ray.dir);
     }
     probe_out[id.x] = vec4<f32>(hit.shading_normal, hit.t);
 }

@@ -123,6 +123,10 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
                 Some((image, scale)) => source(Some(image))?.map(|s| (s, scale)),
                 None => None,
             },
+            clearcoat_normal: match maps.clearcoat_normal {
+                Some((image, scale)) => source(Some(image))?.map(|s| (s, scale)),
+                None => None,
+            },
             roughness_and_metallic: None,
             clearcoat: source(maps.clearcoat)?,
             clearcoat_roughness: source(maps.clearcoat_roughness)?,

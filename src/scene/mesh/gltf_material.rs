@@ -182,7 +182,7 @@ pub(super) fn material(
     // ignored without a word.
     let mut other_textures = false;
     // Pushed once `image` (which warns too) is done with `warnings`.
-    let mut normal_map_warning = None;
+    let mut normal_map_warnings = Vec::new();
     let mut image = |info: &Option<json::texture::Info>, field: &str| {
         let Some(info) = info else {
             return Ok(None);
@@ -250,6 +250,60 @@ pub(super) fn material(
         }
         Ok::<_, String>(Some((root.textures[t].source.value(), sampling)))
     };
+    // A normal map (normalTexture, or the coat's clearcoatNormalTexture at `path`) and its
+    // scale.
+    let mut normal_image =
+        |n: &json::material::NormalTexture, path: &str| -> Result<Option<NormalImage>, String> {
+            let field = format!("materials[{index}].{path}");
+            if !n.scale.is_finite() {
+                return Err(format!("{field}.scale: not finite"));
+            }
+            // The crate keeps a normal texture's extensions unparsed.
+            let transform = n
+                .extensions
+                .as_ref()
+                .and_then(|e| e.others.get("KHR_texture_transform"))
+                .map(|v| {
+                    serde_json::from_value(v.clone())
+                        .map_err(|e| format!("{field}.extensions.KHR_texture_transform: {e}"))
+                })
+                .transpose()?;
+            let info = json::texture::Info {
+                index: n.index,
+                tex_coord: n.tex_coord,
+                extensions: Some(json::extensions::texture::Info {
+                    texture_transform: transform,
+                    others: Default::default(),
+                }),
+                extras: Default::default(),
+            };
+            Ok(match image(&Some(info), path)? {
+                // Tangents (the file's or MikkTSpace's) follow TEXCOORD_0.
+                Some((_, sampling)) if sampling.uv_set != 0 => {
+                    normal_map_warnings.push(format!(
+                    "{field}: on TEXCOORD_1; glint reads normal maps on TEXCOORD_0 only, so the \
+                     texture is ignored"
+                ));
+                    None
+                }
+                i => i.map(|i| (i, n.scale)),
+            })
+        };
+    let normal = match &m.normal_texture {
+        Some(n) => normal_image(n, "normalTexture")?,
+        None => None,
+    };
+    // The coat's own normal map (without one the coat takes the unmapped normal).
+    let clearcoat_normal = match &clearcoat {
+        Some(c) if c.clearcoat_factor > 0.0 => match &c.clearcoat_normal_texture {
+            Some(n) => normal_image(
+                n,
+                "extensions.KHR_materials_clearcoat.clearcoatNormalTexture",
+            )?,
+            None => None,
+        },
+        _ => None,
+    };
     let maps = MaterialImages {
         color: image(
             &pbr.base_color_texture,
@@ -272,45 +326,8 @@ pub(super) fn material(
             )?,
             None => None,
         },
-        normal: match &m.normal_texture {
-            Some(n) => {
-                let field = format!("materials[{index}].normalTexture");
-                if !n.scale.is_finite() {
-                    return Err(format!("{field}.scale: not finite"));
-                }
-                // The crate keeps a normal texture's extensions unparsed.
-                let transform = n
-                    .extensions
-                    .as_ref()
-                    .and_then(|e| e.others.get("KHR_texture_transform"))
-                    .map(|v| {
-                        serde_json::from_value(v.clone())
-                            .map_err(|e| format!("{field}.extensions.KHR_texture_transform: {e}"))
-                    })
-                    .transpose()?;
-                let info = json::texture::Info {
-                    index: n.index,
-                    tex_coord: n.tex_coord,
-                    extensions: Some(json::extensions::texture::Info {
-                        texture_transform: transform,
-                        others: Default::default(),
-                    }),
-                    extras: Default::default(),
-                };
-                match image(&Some(info), "normalTexture")? {
-                    // Tangents (the file's or MikkTSpace's) follow TEXCOORD_0.
-                    Some((_, sampling)) if sampling.uv_set != 0 => {
-                        normal_map_warning = Some(format!(
-                            "{field}: on TEXCOORD_1; glint reads normal maps on TEXCOORD_0 \
-                             only, so the texture is ignored"
-                        ));
-                        None
-                    }
-                    i => i.map(|i| (i, n.scale)),
-                }
-            }
-            None => None,
-        },
+        normal,
+        clearcoat_normal,
         // Textures of a layer whose factor is 0 multiply nothing.
         clearcoat: match &clearcoat {
             Some(c) if c.clearcoat_factor > 0.0 => image(
@@ -341,22 +358,7 @@ pub(super) fn material(
             _ => None,
         },
     };
-    warnings.extend(normal_map_warning);
-    // The coat's own normal map is not rendered yet: the coat takes the base's shading normal.
-    if let Some(c) = clearcoat.as_ref().filter(|c| c.clearcoat_factor > 0.0) {
-        if let Some(n) = &c.clearcoat_normal_texture {
-            if !n.scale.is_finite() {
-                return Err(format!(
-                    "materials[{index}].extensions.KHR_materials_clearcoat.clearcoatNormalTexture.\
-                     scale: not finite"
-                ));
-            }
-            warnings.push(format!(
-                "materials[{index}]: KHR_materials_clearcoat's clearcoatNormalTexture is not \
-                 rendered; the coat follows the base's shading normal"
-            ));
-        }
-    }
+    warnings.extend(normal_map_warnings);
     if let Some(specular) = extensions.and_then(|e| e.specular.as_ref()) {
         other_textures |=
             specular.specular_texture.is_some() || specular.specular_color_texture.is_some();
@@ -369,7 +371,7 @@ pub(super) fn material(
         return Ok((
             Material {
                 name,
-                kind: MaterialKind::Diffuse,
+                kind: MaterialKind::Unlit,
                 color: Vec3::ZERO,
                 emitted_radiance: color,
                 color_texture: None,
@@ -385,6 +387,7 @@ pub(super) fn material(
                 metallic_roughness: None,
                 transmission: None,
                 normal: None,
+                clearcoat_normal: None,
                 clearcoat: None,
                 clearcoat_roughness: None,
                 sheen_color: None,
@@ -442,6 +445,9 @@ fn alpha(m: &json::Material, index: usize) -> Result<Alpha, String> {
     Ok(Alpha { mode, opacity })
 }
 
+/// A normal map's image (an index into `images`), how it is sampled, and its scale.
+pub(super) type NormalImage = ((usize, Sampling), f32);
+
 /// The images (indices into `images`) of a material's texture maps, and how each is sampled.
 pub(super) struct MaterialImages {
     pub(super) color: Option<(usize, Sampling)>,
@@ -450,7 +456,10 @@ pub(super) struct MaterialImages {
     /// KHR_materials_transmission's transmissionTexture (R multiplies the factor).
     pub(super) transmission: Option<(usize, Sampling)>,
     /// The normal map and its scale.
-    pub(super) normal: Option<((usize, Sampling), f32)>,
+    pub(super) normal: Option<NormalImage>,
+    /// KHR_materials_clearcoat's clearcoatNormalTexture and its scale: the coat's own normal
+    /// map.
+    pub(super) clearcoat_normal: Option<NormalImage>,
     /// KHR_materials_clearcoat's clearcoatTexture (R multiplies the factor) and
     /// clearcoatRoughnessTexture (G multiplies the roughness).
     pub(super) clearcoat: Option<(usize, Sampling)>,

@@ -148,6 +148,8 @@ pub(super) struct FileTextures {
     transmission: Option<(Rc<ImageSource>, Sampling)>,
     /// glTF's `normalTexture` (linear), and its scale.
     normal: Option<((Rc<ImageSource>, Sampling), f32)>,
+    /// KHR_materials_clearcoat's `clearcoatNormalTexture` (linear), and its scale.
+    clearcoat_normal: Option<((Rc<ImageSource>, Sampling), f32)>,
     /// OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, merged on load.
     roughness_and_metallic: Option<(Option<PathBuf>, Option<PathBuf>)>,
     /// KHR_materials_clearcoat's clearcoatTexture (red) and clearcoatRoughnessTexture (green).
@@ -334,6 +336,11 @@ pub(crate) fn load_placed(
                                 load(&maps.sheen_color, TextureUse::Color)?;
                             layers.sheen_roughness_texture =
                                 load(&maps.sheen_roughness, TextureUse::SheenRoughness)?;
+                            if let Some((map, scale)) = &maps.clearcoat_normal {
+                                layers.clearcoat_normal_texture =
+                                    load(&Some(map.clone()), TextureUse::Normal)?
+                                        .map(|t| (t, *scale));
+                            }
                         }
                         if let Some((map, scale)) = &maps.normal {
                             m.normal_texture =
@@ -366,9 +373,9 @@ pub(crate) fn load_placed(
             }
         };
         let count = geometry.positions.len();
-        // Normal maps need tangents at every corner (tangents.rs), read or made once per
-        // geometry.
-        let corners = if scene_materials[material as usize].normal_texture.is_some() {
+        // Normal maps (the coat's too) need tangents at every corner (tangents.rs), read or
+        // made once per geometry.
+        let corners = if scene_materials[material as usize].has_normal_map() {
             if geometry.uvs.len() != count {
                 return Err(format!(
                     "{shown}: {}material {:?} has a normal map, but these triangles have no \
