@@ -160,8 +160,11 @@ pub(super) fn validate_objects(
             None => vec![transform.matrix()],
             Some(list) => list.iter().map(|i| *i * transform.matrix()).collect(),
         };
-        // Stored once when it has several instances and the material named here (if any)
-        // allows it; a file's own materials are known only once it is read.
+        // Stored once (the two-level structure) when it has two or more instances and the
+        // material named here, if any, allows it (a file's own materials are known only once
+        // it is read). Two: from there on a copy saves memory, whatever the mesh's size, and
+        // the rule is one a user can predict; a single instance is just the mesh placed, so
+        // it stays in the scene's triangles, which no ray has to transform into.
         let once = instance_matrices.as_ref().filter(|list| {
             list.len() >= 2 && material.is_none_or(|id| two_level(&materials.list[id as usize]))
         });
