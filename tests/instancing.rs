@@ -665,3 +665,39 @@ fn gltf_lights_are_placed_with_every_instance() {
         );
     }
 }
+
+/// The hardware traversal does not trace instances yet: `--traversal hardware` is refused with
+/// that reason, `auto` takes the software traversal, and a hardware renderer is refused too,
+/// rather than drawing each mesh once in its own coordinates.
+#[test]
+fn hardware_traversal_refuses_instances() {
+    use glint::gpu::renderer::GpuRenderer;
+    use glint::gpu::traversal::{Traversal, TraversalChoice};
+    let Some(ctx) = gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let (instanced, _) = instanced_and_flattened(dir.path(), "white");
+    let scene = lit(instanced);
+    let e = TraversalChoice::Hardware
+        .resolve_for(ctx, &scene)
+        .expect_err("hardware with instances");
+    let message = e.to_string();
+    for needle in [
+        "--traversal hardware",
+        "instanced meshes",
+        "--traversal software",
+    ] {
+        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    }
+    for choice in [TraversalChoice::Auto, TraversalChoice::Software] {
+        assert_eq!(
+            choice.resolve_for(ctx, &scene).unwrap(),
+            Traversal::Software
+        );
+    }
+    if ctx.has_ray_queries() {
+        let e = GpuRenderer::with_traversal(ctx, &scene, Traversal::Hardware)
+            .err()
+            .expect("a hardware renderer of instances");
+        assert!(e.to_string().contains("instanced meshes"), "{e}");
+    }
+}
