@@ -1,5 +1,6 @@
-// BVH traversal (mirror: src/cpu/bvh.rs). One BVH over every sphere, quad and triangle, built
-// on the host (src/scene/bvh.rs) and flattened into bvh_nodes. A fixed stack, the nearer child
+// BVH traversal (mirror: src/cpu/bvh.rs). One BVH over every sphere, quad, triangle and
+// instance, built on the host (src/scene/bvh.rs) and flattened into bvh_nodes; an instance's
+// leaf entry walks its mesh's own BVH (shaders/traverse/blas.wgsl). A fixed stack, the nearer child
 // first, and popped nodes skipped when they start beyond the closest hit so far. Shadow rays
 // stop at the first primitive in front of the one they aim at. Which hit is the closest, and
 // which primitives are in front, is the closest-hit rule's (hit_comes_first), whatever the
@@ -108,7 +109,7 @@ fn primitive_box_entry(reference: u32, r: BvhRay) -> f32 {
 const NO_PRIMITIVE: u32 = 0xffffffffu;
 
 fn bvh_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
-    var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u);
+    var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
     var best_reference = max_reference;
     var prune = t_prune;
     var found = false;
@@ -120,18 +121,34 @@ fn bvh_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_
     // Where the ray enters the node being entered.
     var node_entry = hit_box(bvh_node(0u), r, prune);
     if node_entry == NO_HIT {
-        return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
+        return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
     }
     loop {
         let node = bvh_node(node_index);
         if node.count > 0u {
             for (var i = 0u; i < node.count; i++) {
                 let reference = bvh_primitives[node.first + i];
+                if HAS_INSTANCES && (reference >> PRIMITIVE_KIND_SHIFT) == PRIMITIVE_INSTANCE {
+                    // Its closest triangle that comes before the best so far: at the same t
+                    // only if this reference is the lower (the rule, extended by triangle).
+                    let instance = reference & PRIMITIVE_INDEX_MASK;
+                    let h = hit_instance(instance, r.ray, best.t, reference < best_reference, prune, shadow_target != NO_PRIMITIVE);
+                    if h.t != NO_HIT {
+                        best = ClosestPrimitive(h.t, PRIMITIVE_TRIANGLE, h.triangle, instance);
+                        best_reference = reference;
+                        prune = max(h.prune, node_entry);
+                        found = true;
+                        if shadow_target != NO_PRIMITIVE {
+                            return best;
+                        }
+                    }
+                    continue;
+                }
                 let t = hit_primitive(reference, r);
                 // The target is excluded by name too, not only by the rule: the compiler may
                 // round its test here and in bvh_first_hit_is differently.
                 if hit_comes_first(t, reference, best.t, best_reference) && reference != shadow_target {
-                    best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK);
+                    best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK, NO_INSTANCE);
                     best_reference = reference;
                     prune = max(t, node_entry);
                     found = true;
@@ -189,9 +206,14 @@ fn bvh_closest_primitive(ray: Ray) -> ClosestPrimitive {
     return bvh_traverse(bvh_ray(ray), NO_HIT, NO_HIT, 0u, NO_PRIMITIVE);
 }
 
+// A shadow target no leaf holds: bvh_escapes' search for any hit. Not a kind's first
+// reference (PRIMITIVE_INSTANCE << PRIMITIVE_KIND_SHIFT is instance 0's), but the last one
+// below NO_PRIMITIVE, which no scene has that many instances to reach.
+const NO_TARGET: u32 = 0xfffffffeu;
+
 // Whether ray hits nothing: a shadow-ray search for any hit, with no target.
 fn bvh_escapes(ray: Ray) -> bool {
-    return bvh_traverse(bvh_ray(ray), NO_HIT, NO_HIT, 0u, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
+    return bvh_traverse(bvh_ray(ray), NO_HIT, NO_HIT, 0u, NO_TARGET).t == NO_HIT;
 }
 
 fn bvh_first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {

@@ -78,15 +78,19 @@ fn hit_quad(q: Quad, ray: Ray) -> f32 {
 struct ClosestPrimitive {
     // NO_HIT when the ray meets nothing.
     t: f32,
-    // PRIMITIVE_SPHERE or PRIMITIVE_QUAD, and its index.
+    // PRIMITIVE_SPHERE, PRIMITIVE_QUAD or PRIMITIVE_TRIANGLE, and its index.
     primitive: u32,
     index: u32,
+    // The instance a triangle was hit through (shaders/instance.wgsl), or NO_INSTANCE: index
+    // is then the triangle's in the arrays, which hold it in the instance's coordinates.
+    instance: u32,
 }
 
 // The closest-hit rule, the same for every traversal on every device so that any structure
 // finds the same hit: the smallest t, and among equal t the lowest primitive reference,
 // (kind << PRIMITIVE_KIND_SHIFT) | index, that is spheres first, then quads, then triangles,
-// each by index. Whether a hit at t on `reference` comes before the best so far.
+// then instances, each by index; among an instance's own triangles at equal t, the lowest
+// triangle index (shaders/traverse/blas.wgsl). Whether a hit at t on `reference` comes before the best so far.
 fn hit_comes_first(t: f32, reference: u32, best_t: f32, best_reference: u32) -> bool {
     return t < best_t || (t == best_t && reference < best_reference);
 }
@@ -103,22 +107,23 @@ fn closest_primitive(ray: Ray) -> ClosestPrimitive {
     return scan_closest_primitive(ray);
 }
 
-// The closest primitive by testing every one: the structure without a BVH, and what every other
-// traversal must agree with. It visits primitives in the closest-hit rule's order
+// The closest primitive by testing every one (every instance's every triangle too, after the
+// triangles placed as they are: triangle_count() counts those): the structure without a BVH,
+// and what every other traversal must agree with. It visits primitives in the closest-hit rule's order
 // (hit_comes_first) and keeps only strictly nearer hits, so among equal t the first, the lowest
 // reference, wins.
 fn scan_closest_primitive(ray: Ray) -> ClosestPrimitive {
-    var best = ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
+    var best = ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
     for (var i = 0u; i < sphere_count(); i++) {
         let t = hit_sphere(spheres[i], ray);
         if t < best.t {
-            best = ClosestPrimitive(t, PRIMITIVE_SPHERE, i);
+            best = ClosestPrimitive(t, PRIMITIVE_SPHERE, i, NO_INSTANCE);
         }
     }
     for (var i = 0u; i < quad_count(); i++) {
         let t = hit_quad(quads[i], ray);
         if t < best.t {
-            best = ClosestPrimitive(t, PRIMITIVE_QUAD, i);
+            best = ClosestPrimitive(t, PRIMITIVE_QUAD, i, NO_INSTANCE);
         }
     }
     if HAS_TRIANGLES && triangle_count() > 0u {
@@ -126,9 +131,12 @@ fn scan_closest_primitive(ray: Ray) -> ClosestPrimitive {
         for (var i = 0u; i < triangle_count(); i++) {
             let t = hit_scene_triangle(i, r);
             if t < best.t {
-                best = ClosestPrimitive(t, PRIMITIVE_TRIANGLE, i);
+                best = ClosestPrimitive(t, PRIMITIVE_TRIANGLE, i, NO_INSTANCE);
             }
         }
+    }
+    if HAS_INSTANCES {
+        best = scan_instances(ray, best);
     }
     return best;
 }
@@ -145,7 +153,8 @@ fn first_hit_is(ray: Ray, primitive: u32, index: u32) -> bool {
         return bvh_first_hit_is(ray, primitive, index);
     }
     let closest = closest_primitive(ray);
-    return closest.t != NO_HIT && closest.primitive == primitive && closest.index == index;
+    // A target is placed as it is: a light never goes through an instance.
+    return closest.t != NO_HIT && closest.primitive == primitive && closest.index == index && closest.instance == NO_INSTANCE;
 }
 
 // Whether ray leaves the scene without hitting anything (it then sees the environment).
@@ -184,7 +193,7 @@ fn intersect_scene(ray: Ray) -> Hit {
             hit.uv = both_sets(sphere_uv(outward));
         }
     } else if HAS_TRIANGLES && closest.primitive == PRIMITIVE_TRIANGLE {
-        let tri = triangles[closest.index];
+        let tri = scene_triangle(closest.instance, closest.index);
         let b = triangle_barycentrics(tri, triangle_ray(ray));
         hit.barycentrics = b;
         outward = triangle_normal(tri);
@@ -196,7 +205,7 @@ fn intersect_scene(ray: Ray) -> Hit {
         if HAS_TEXTURES {
             hit.uv = triangle_uv(closest.index, b);
         }
-        let n = triangle_normals[closest.index];
+        let n = scene_triangle_normals(closest.instance, closest.index);
         if n.smooth_shading != 0u {
             shading = normalize(b.x * n.n0 + b.y * n.n1 + b.z * n.n2);
         }

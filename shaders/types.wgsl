@@ -194,6 +194,22 @@ struct BvhNode {
 const PRIMITIVE_KIND_SHIFT: u32 = 30u;
 const PRIMITIVE_INDEX_MASK: u32 = 0x3fffffffu;
 
+// A top-level reference's kind for an instance; 3 is also PRIMITIVE_ENVIRONMENT, a light's kind
+// that never appears in a leaf.
+const PRIMITIVE_INSTANCE: u32 = 3u;
+// ClosestPrimitive.instance of a primitive placed as it is.
+const NO_INSTANCE: u32 = 0xffffffffu;
+
+// A placement of an instanced mesh (src/shader_types.rs says what each field holds).
+struct Instance {
+    to_world: array<vec4<f32>, 3>,
+    to_object: array<vec4<f32>, 3>,
+    blas_root: u32,
+    first_triangle: u32,
+    triangle_count: u32,
+    _pad: u32,
+}
+
 // One entry per emitting primitive, for choosing one in proportion to its power.
 // One entry per emitter and one slot of the alias table over them (src/shader_types.rs).
 struct Emitter {

@@ -84,6 +84,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         environment_texels,
         environment_alias,
         lights,
+        instances,
     } = scene;
     let mut params = *params;
     params.sample_start = 0;
@@ -115,6 +116,15 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     );
     array("environment alias", bytemuck::cast_slice(environment_alias));
     array("lights", bytemuck::cast_slice(lights));
+    // Only where there are instances, so the hashes of scenes without them stay as they were;
+    // without the BVH's node index, which is the BVH's as above.
+    if !instances.is_empty() {
+        let placed: Vec<_> = instances
+            .iter()
+            .map(|i| crate::shader_types::Instance { blas_root: 0, ..*i })
+            .collect();
+        array("instances", bytemuck::cast_slice(&placed));
+    }
     let mut hex = String::with_capacity(64);
     for byte in hasher.finalize() {
         write!(hex, "{byte:02x}").expect("writing to a String");

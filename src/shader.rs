@@ -10,7 +10,7 @@ use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 34] = [
+pub const SHADER_PARTS: [(&str, &str); 36] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -22,6 +22,11 @@ pub const SHADER_PARTS: [(&str, &str); 34] = [
     ("triangle.wgsl", include_str!("../shaders/triangle.wgsl")),
     ("intersect.wgsl", include_str!("../shaders/intersect.wgsl")),
     ("bvh.wgsl", include_str!("../shaders/bvh.wgsl")),
+    ("instance.wgsl", include_str!("../shaders/instance.wgsl")),
+    (
+        "traverse/blas.wgsl",
+        include_str!("../shaders/traverse/blas.wgsl"),
+    ),
     ("frame.wgsl", include_str!("../shaders/frame.wgsl")),
     ("bsdf.wgsl", include_str!("../shaders/bsdf.wgsl")),
     (
@@ -305,6 +310,9 @@ pub struct KernelFeatures {
     pub alpha: bool,
     /// Meshes with vertex colours (glTF's COLOR_0, shaders/vertex_color.wgsl).
     pub vertex_colors: bool,
+    /// Instanced meshes (shaders/instance.wgsl, shaders/traverse/blas.wgsl): without them no
+    /// top-level leaf is an instance and every triangle is read as it is stored.
+    pub instances: bool,
     /// Textures on the second texture coordinate set (glTF's TEXCOORD_1, shaders/texture.wgsl).
     pub texcoord1: bool,
 }
@@ -330,6 +338,7 @@ impl KernelFeatures {
         sun_disks: true,
         alpha: true,
         vertex_colors: true,
+        instances: true,
         texcoord1: true,
     };
 
@@ -369,6 +378,7 @@ impl KernelFeatures {
                 .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
             alpha: has_alpha(&scene.materials),
             vertex_colors: !scene.triangle_colors.is_empty(),
+            instances: !scene.instances.is_empty(),
             texcoord1: !scene.triangle_uvs1.is_empty(),
         }
     }
@@ -394,6 +404,7 @@ impl KernelFeatures {
             && needs(self.sun_disks, other.sun_disks)
             && needs(self.alpha, other.alpha)
             && needs(self.vertex_colors, other.vertex_colors)
+            && needs(self.instances, other.instances)
             && needs(self.texcoord1, other.texcoord1)
     }
 
@@ -409,7 +420,7 @@ impl KernelFeatures {
              const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
              const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
              const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
-             const HAS_TEXCOORD_1: bool = {};\n",
+             const HAS_TEXCOORD_1: bool = {};\nconst HAS_INSTANCES: bool = {};\n",
             self.light_sampling,
             self.sphere_emitters,
             self.quad_emitters,
@@ -428,7 +439,8 @@ impl KernelFeatures {
             self.sun_disks,
             self.alpha,
             self.vertex_colors,
-            self.textures && self.texcoord1
+            self.textures && self.texcoord1,
+            self.instances
         )
     }
 }

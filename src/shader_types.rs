@@ -245,6 +245,31 @@ pub struct BvhNode {
 pub const PRIMITIVE_KIND_SHIFT: u32 = 30;
 pub const PRIMITIVE_INDEX_MASK: u32 = (1 << PRIMITIVE_KIND_SHIFT) - 1;
 
+/// A top-level BVH reference's kind for an instance (`Instance`): the one kind a leaf holds
+/// that is not a light's, so it may share the value 3 with [`PRIMITIVE_ENVIRONMENT`], which
+/// names a light and never appears in a leaf.
+pub const PRIMITIVE_INSTANCE: u32 = 3;
+
+/// `ClosestPrimitive::instance` of a hit on a primitive placed as it is (not through an
+/// instance): its arrays hold it in the scene's coordinates.
+pub const NO_INSTANCE: u32 = u32::MAX;
+
+/// A placement of an instanced mesh (`src/scene/kernel.rs` lays them out, `shaders/instance.wgsl`
+/// reads them): its transforms as the rows of 3×4 matrices (a point p goes to
+/// `(row · (p, 1))` per row), and its mesh's bottom-level BVH, whose root is
+/// `bvh_nodes[blas_root]` and whose leaves reference the mesh's triangles, stored once in the
+/// mesh's own coordinates at `triangles[first_triangle ..][.. triangle_count]`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Instance {
+    pub to_world: [[f32; 4]; 3],
+    pub to_object: [[f32; 4]; 3],
+    pub blas_root: u32,
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    pub _pad: u32,
+}
+
 pub const TEXTURE_IMAGE: u32 = 0;
 pub const TEXTURE_CHECKER: u32 = 1;
 

@@ -65,6 +65,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             material: 0,
         }],
         triangles: vec![],
+        instanced: vec![],
         textures: Default::default(),
         environment: None,
         lights: vec![],

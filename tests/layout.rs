@@ -7,8 +7,8 @@ use glint::shader::{
     WORKGROUP_SIZE,
 };
 use glint::shader_types::{
-    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs,
+    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material, Params, Quad,
+    Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs,
 };
 use glint::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use naga::proc::Layouter;
@@ -208,6 +208,19 @@ fn rust_structs_match_wgsl_layout() {
     assert_same_layout!(&module, BvhNode, "BvhNode", [min, first, max, count]);
     assert_same_layout!(
         &module,
+        Instance,
+        "Instance",
+        [
+            to_world,
+            to_object,
+            blas_root,
+            first_triangle,
+            triangle_count,
+            _pad
+        ]
+    );
+    assert_same_layout!(
+        &module,
         Light,
         "Light",
         [
@@ -398,6 +411,8 @@ fn every_feature_combination_validates() {
             vertex_colors: (bits * 11 / 7) % 2 == 1,
             // Likewise, with and without textures.
             texcoord1: (bits * 13 / 9) % 2 == 1,
+            // Likewise, with and without alpha.
+            instances: (bits * 17 / 11) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -440,6 +455,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         alpha: false,
         vertex_colors: false,
         texcoord1: false,
+        instances: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

@@ -35,7 +35,7 @@ fn hardware_bound(t: f32) -> f32 {
 // never committed; instead the query starts over, reaching only to hardware_bound(t).
 fn hardware_traverse(ray: Ray, t_max: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
     let r = bvh_ray(ray);
-    var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u);
+    var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
     var best_reference = max_reference;
     var found = false;
     var reach = hardware_bound(t_max);
@@ -55,7 +55,7 @@ fn hardware_traverse(ray: Ray, t_max: f32, max_reference: u32, shadow_target: u3
             if !hit_comes_first(t, reference, best.t, best_reference) || reference == shadow_target {
                 continue;
             }
-            best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK);
+            best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK, NO_INSTANCE);
             best_reference = reference;
             found = true;
             if shadow_target != NO_PRIMITIVE {

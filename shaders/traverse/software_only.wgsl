@@ -3,7 +3,7 @@
 // calls them: the variant compiles without ray queries, and these cost nothing.
 
 fn hardware_closest_primitive(ray: Ray) -> ClosestPrimitive {
-    return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u);
+    return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
 }
 
 fn hardware_escapes(ray: Ray) -> bool {

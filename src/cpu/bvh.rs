@@ -1,5 +1,6 @@
-//! BVH traversal (WGSL side: `shaders/bvh.wgsl`). One BVH over every sphere, quad and triangle,
-//! built on the host (`src/scene/bvh.rs`) and flattened into `bvh_nodes`. A fixed stack, the
+//! BVH traversal (WGSL side: `shaders/bvh.wgsl`). One BVH over every sphere, quad, triangle
+//! and instance, built on the host (`src/scene/bvh.rs`) and flattened into `bvh_nodes`; an
+//! instance's leaf entry walks its mesh's own BVH (`src/cpu/traverse/blas.rs`). A fixed stack, the
 //! nearer child first, and popped nodes skipped when they start beyond the closest hit so far.
 //! Shadow rays stop at the first primitive in front of the one they aim at. Which hit is the
 //! closest, and which primitives are in front, is the closest-hit rule's
@@ -7,11 +8,12 @@
 
 use super::alpha::hit_scene_triangle;
 use super::intersect::{hit_comes_first, hit_quad, hit_sphere, ClosestPrimitive, Geometry, NO_HIT};
+use super::traverse::blas::hit_instance;
 use super::triangle::{triangle_ray, TriangleRay};
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, PRIMITIVE_ENVIRONMENT, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
-    PRIMITIVE_TRIANGLE,
+    BvhNode, NO_INSTANCE, PRIMITIVE_INDEX_MASK, PRIMITIVE_INSTANCE, PRIMITIVE_KIND_SHIFT,
+    PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec3, Vec3A};
 
@@ -116,6 +118,7 @@ pub fn bvh_traverse(
         t: t_max,
         primitive: PRIMITIVE_QUAD,
         index: 0,
+        instance: NO_INSTANCE,
     };
     let mut best_reference = max_reference;
     let mut prune = t_prune;
@@ -128,6 +131,7 @@ pub fn bvh_traverse(
             t: NO_HIT,
             primitive: PRIMITIVE_QUAD,
             index: 0,
+            instance: NO_INSTANCE,
         };
     }
     // The node being entered, as its first and count, read with its box when its parent was
@@ -144,6 +148,35 @@ pub fn bvh_traverse(
         if count > 0 {
             for i in first..first + count {
                 let reference = geometry.bvh_primitives[i as usize];
+                if reference >> PRIMITIVE_KIND_SHIFT == PRIMITIVE_INSTANCE {
+                    // Its closest triangle that comes before the best so far: at the same t
+                    // only if this reference is the lower (the rule, extended by triangle).
+                    let instance = reference & PRIMITIVE_INDEX_MASK;
+                    let h = hit_instance(
+                        geometry,
+                        instance,
+                        &r.ray,
+                        best.t,
+                        reference < best_reference,
+                        prune,
+                        shadow_target != NO_PRIMITIVE,
+                    );
+                    if h.t != NO_HIT {
+                        best = ClosestPrimitive {
+                            t: h.t,
+                            primitive: PRIMITIVE_TRIANGLE,
+                            index: h.triangle,
+                            instance,
+                        };
+                        best_reference = reference;
+                        prune = h.prune.max(node_entry);
+                        found = true;
+                        if shadow_target != NO_PRIMITIVE {
+                            return best;
+                        }
+                    }
+                    continue;
+                }
                 let t = hit_primitive(geometry, reference, r);
                 // The target is excluded by name too, not only by the rule: a shader compiler
                 // may round its test here and in `bvh_first_hit_is` differently.
@@ -154,6 +187,7 @@ pub fn bvh_traverse(
                         t,
                         primitive: reference >> PRIMITIVE_KIND_SHIFT,
                         index: reference & PRIMITIVE_INDEX_MASK,
+                        instance: NO_INSTANCE,
                     };
                     best_reference = reference;
                     prune = t.max(node_entry);
@@ -241,10 +275,14 @@ pub fn bvh_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive
     bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_HIT, 0, NO_PRIMITIVE)
 }
 
+/// A shadow target no leaf holds: [`bvh_escapes`]' search for any hit. Not a kind's first
+/// reference (`PRIMITIVE_INSTANCE << PRIMITIVE_KIND_SHIFT` is instance 0's), but the last one
+/// below [`NO_PRIMITIVE`], which no scene has that many instances to reach.
+pub const NO_TARGET: u32 = u32::MAX - 1;
+
 /// Whether `ray` hits nothing: a shadow-ray search for any hit, with no target.
 pub fn bvh_escapes(geometry: &Geometry, ray: &Ray) -> bool {
-    let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
-    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_HIT, 0, no_target).t == NO_HIT
+    bvh_traverse(geometry, &bvh_ray(ray), NO_HIT, NO_HIT, 0, NO_TARGET).t == NO_HIT
 }
 
 pub fn bvh_first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u32) -> bool {

@@ -2,6 +2,7 @@
 
 use super::alpha::{hit_scene_triangle, AlphaTest};
 use super::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
+use super::instance::{own_triangle_count, scan_instances, scene_triangle, scene_triangle_normals};
 use super::shading_normal::valid_shading_normal;
 use super::surface::{parametric_point, sphere_point};
 use super::texture::{both_sets, sphere_uv, triangle_uv};
@@ -10,8 +11,8 @@ use super::triangle::{
 };
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
-    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, Instance, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, NO_INSTANCE,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -25,6 +26,8 @@ pub struct Geometry<'a> {
     pub triangle_normals: &'a [TriangleNormals],
     pub bvh_nodes: &'a [BvhNode],
     pub bvh_primitives: &'a [u32],
+    /// Instanced meshes' placements (`instance.rs`); empty without any.
+    pub instances: &'a [Instance],
     /// One per triangle when `textured`.
     pub triangle_uvs: &'a [TriangleUvs],
     /// The second set, where a texture reads it (else empty).
@@ -129,9 +132,12 @@ pub fn hit_quad(q: &Quad, ray: &Ray) -> f32 {
 pub struct ClosestPrimitive {
     /// `NO_HIT` when the ray meets nothing.
     pub t: f32,
-    /// `PRIMITIVE_SPHERE` or `PRIMITIVE_QUAD`, and its index.
+    /// `PRIMITIVE_SPHERE`, `PRIMITIVE_QUAD` or `PRIMITIVE_TRIANGLE`, and its index.
     pub primitive: u32,
     pub index: u32,
+    /// The instance a triangle was hit through (`instance.rs`), or `NO_INSTANCE`: `index` is
+    /// then the triangle's in the arrays, which hold it in the instance's coordinates.
+    pub instance: u32,
 }
 
 /// The closest-hit rule, the same for every traversal on every device so that any structure
@@ -158,6 +164,7 @@ pub fn scan_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitiv
         t: NO_HIT,
         primitive: PRIMITIVE_QUAD,
         index: 0,
+        instance: NO_INSTANCE,
     };
     for (i, s) in geometry.spheres.iter().enumerate() {
         let t = hit_sphere(s, ray);
@@ -166,6 +173,7 @@ pub fn scan_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitiv
                 t,
                 primitive: PRIMITIVE_SPHERE,
                 index: i as u32,
+                instance: NO_INSTANCE,
             };
         }
     }
@@ -176,23 +184,26 @@ pub fn scan_closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitiv
                 t,
                 primitive: PRIMITIVE_QUAD,
                 index: i as u32,
+                instance: NO_INSTANCE,
             };
         }
     }
-    if !geometry.triangles.is_empty() {
+    let own = own_triangle_count(geometry);
+    if own > 0 {
         let r = triangle_ray(ray);
-        for (i, tri) in geometry.triangles.iter().enumerate() {
+        for (i, tri) in geometry.triangles[..own].iter().enumerate() {
             let t = hit_scene_triangle(&geometry.alpha, i as u32, tri, &r);
             if t < best.t {
                 best = ClosestPrimitive {
                     t,
                     primitive: PRIMITIVE_TRIANGLE,
                     index: i as u32,
+                    instance: NO_INSTANCE,
                 };
             }
         }
     }
-    best
+    scan_instances(geometry, ray, best)
 }
 
 /// Whether the first thing `ray` meets is the primitive (`primitive`, `index`).
@@ -204,7 +215,11 @@ pub fn first_hit_is(geometry: &Geometry, ray: &Ray, primitive: u32, index: u32) 
         return bvh_first_hit_is(geometry, ray, primitive, index);
     }
     let closest = closest_primitive(geometry, ray);
-    closest.t != NO_HIT && closest.primitive == primitive && closest.index == index
+    // A target is placed as it is: a light never goes through an instance.
+    closest.t != NO_HIT
+        && closest.primitive == primitive
+        && closest.index == index
+        && closest.instance == NO_INSTANCE
 }
 
 /// Whether `ray` leaves the scene without hitting anything (it then sees the environment).
@@ -251,10 +266,10 @@ pub fn intersect_scene(geometry: &Geometry, ray: &Ray) -> Hit {
             s.material,
         )
     } else if closest.primitive == PRIMITIVE_TRIANGLE {
-        let tri = &geometry.triangles[closest.index as usize];
+        let tri = &scene_triangle(geometry, closest.instance, closest.index);
         let b = triangle_barycentrics(tri, &triangle_ray(ray));
         barycentrics = b;
-        let n = &geometry.triangle_normals[closest.index as usize];
+        let n = &scene_triangle_normals(geometry, closest.instance, closest.index);
         if n.smooth_shading != 0 {
             shading = (b.x * Vec3::from(n.n0) + b.y * Vec3::from(n.n1) + b.z * Vec3::from(n.n2))
                 .normalize();

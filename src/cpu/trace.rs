@@ -21,9 +21,9 @@ use super::Ray;
 use crate::scene::KernelScene;
 use crate::shader::has_alpha;
 use crate::shader_types::{
-    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs, NO_TEXTURE,
-    PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
+    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material, Params, Quad,
+    Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs,
+    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -40,6 +40,8 @@ pub struct SceneRefs<'a> {
     /// Empty: every ray tests every primitive.
     pub bvh_nodes: &'a [BvhNode],
     pub bvh_primitives: &'a [u32],
+    /// Empty: no instanced meshes.
+    pub instances: &'a [Instance],
     /// Texture descriptors and texels (`texture.rs`); empty without textures.
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
@@ -76,6 +78,7 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: &scene.triangle_normals,
             bvh_nodes: &scene.bvh_nodes,
             bvh_primitives: &scene.bvh_primitives,
+            instances: &scene.instances,
             environment_texels: &scene.environment_texels,
             environment_alias: &scene.environment_alias,
             textures: &scene.textures,
@@ -115,6 +118,7 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: self.triangle_normals,
             bvh_nodes: self.bvh_nodes,
             bvh_primitives: self.bvh_primitives,
+            instances: self.instances,
             triangle_uvs: self.triangle_uvs,
             triangle_uvs1: self.triangle_uvs1,
             textured: !self.textures.is_empty(),

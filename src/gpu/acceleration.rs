@@ -144,12 +144,23 @@ const MAX_CUSTOM_DATA: usize = (1 << 24) - 1;
 
 /// Builds `scene`'s acceleration structure on `ctx`'s device, which must have ray queries.
 /// A scene over the device's limits is an error naming the limit.
+/// Why a scene with instances cannot take the hardware traversal: its acceleration structure
+/// would need an instance level of its own (a TLAS instance per placement over one BLAS per
+/// mesh), which is not built yet, and tracing the stored triangles as they are would draw each
+/// mesh once, in its own coordinates: a wrong image. The software traversal traces them.
+pub const INSTANCES_UNSUPPORTED: &str = "the scene has instanced meshes ([[meshes]] instances), \
+     which the hardware traversal (ray queries) does not trace yet; use --traversal software or \
+     auto";
+
 pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStructure> {
     if !ctx.has_ray_queries() {
         return Err(anyhow!(
             "{} has no ray queries (wgpu's EXPERIMENTAL_RAY_QUERY), which the hardware traversal needs",
             ctx.device_name()
         ));
+    }
+    if !scene.instances.is_empty() {
+        return Err(anyhow!("{INSTANCES_UNSUPPORTED}"));
     }
     let started = std::time::Instant::now();
     let device = &ctx.device;

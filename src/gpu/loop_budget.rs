@@ -36,7 +36,10 @@ pub fn loop_iterations_per_ray(scene: &KernelScene) -> u64 {
             + params.triangle_count as u64;
     }
     let inner_nodes = scene.bvh_nodes.iter().filter(|n| n.count == 0).count() as u64;
-    scene.bvh_nodes.len() as u64 + scene.bvh_primitives.len() as u64 + inner_nodes
+    let one_walk = scene.bvh_nodes.len() as u64 + scene.bvh_primitives.len() as u64 + inner_nodes;
+    // Each instance's leaf walks its mesh's tree (shaders/traverse/blas.wgsl), which the one
+    // walk above bounds, once per instance at most.
+    one_walk * (1 + scene.instances.len() as u64)
 }
 
 /// The most loop iterations one sample can take: for the camera ray and each scattering event,

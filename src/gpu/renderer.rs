@@ -276,6 +276,7 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.bvh_primitives),
                     read_only,
                 ),
+                BufferNeed::new("instances", array_bytes(&scene.instances), read_only),
                 BufferNeed::new("textures", array_bytes(&scene.textures), read_only),
                 BufferNeed::new(
                     "triangle texture coordinates",
@@ -342,6 +343,7 @@ impl<'a> GpuRenderer<'a> {
             wgpu::BufferUsages::UNIFORM,
         );
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+        let instances = storage_buffer(ctx, "instances", &scene.instances);
         // Textures are storage buffers in every layout (shaders/texture.wgsl says why).
         let textures = storage_buffer(ctx, "textures", &scene.textures);
         let texels: Vec<_> = texel_windows
@@ -459,6 +461,7 @@ impl<'a> GpuRenderer<'a> {
             (12, read_only, &bvh_nodes),
             (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
             (13, read_only, &bvh_primitives),
+            (40, read_only, &instances),
             (10, read_write, &aov_buffers[0]),
             (11, read_write, &aov_buffers[1]),
             (16, read_write, &nonfinite_buffer),

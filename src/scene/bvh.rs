@@ -5,8 +5,8 @@
 
 use crate::cpu::bvh::BVH_STACK_SIZE;
 use crate::shader_types::{
-    BvhNode, Quad, Sphere, Triangle, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, Quad, Sphere, Triangle, PRIMITIVE_INDEX_MASK, PRIMITIVE_INSTANCE,
+    PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 use obvhs::aabb::Aabb;
@@ -35,8 +35,14 @@ fn aabb(min: Vec3, max: Vec3) -> Aabb {
     Aabb::new(min.to_array().into(), max.to_array().into())
 }
 
-fn primitive_boxes(spheres: &[Sphere], quads: &[Quad], triangles: &[Triangle]) -> Vec<Aabb> {
-    let mut boxes = Vec::with_capacity(spheres.len() + quads.len() + triangles.len());
+fn primitive_boxes(
+    spheres: &[Sphere],
+    quads: &[Quad],
+    triangles: &[Triangle],
+    instances: &[(Vec3, Vec3)],
+) -> Vec<Aabb> {
+    let mut boxes =
+        Vec::with_capacity(spheres.len() + quads.len() + triangles.len() + instances.len());
     for s in spheres {
         let c = Vec3::from(s.center);
         boxes.push(aabb(c - s.radius, c + s.radius));
@@ -53,17 +59,20 @@ fn primitive_boxes(spheres: &[Sphere], quads: &[Quad], triangles: &[Triangle]) -
         let (a, b, c) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
         boxes.push(aabb(a.min(b).min(c), a.max(b).max(c)));
     }
+    boxes.extend(instances.iter().map(|&(min, max)| aabb(min, max)));
     boxes
 }
 
 /// The reference a leaf stores for the i-th primitive in [`primitive_boxes`]' order.
-fn reference(i: usize, spheres: usize, quads: usize) -> u32 {
+fn reference(i: usize, spheres: usize, quads: usize, triangles: usize) -> u32 {
     let (kind, index) = if i < spheres {
         (PRIMITIVE_SPHERE, i)
     } else if i < spheres + quads {
         (PRIMITIVE_QUAD, i - spheres)
-    } else {
+    } else if i < spheres + quads + triangles {
         (PRIMITIVE_TRIANGLE, i - spheres - quads)
+    } else {
+        (PRIMITIVE_INSTANCE, i - spheres - quads - triangles)
     };
     (kind << PRIMITIVE_KIND_SHIFT) | index as u32
 }
@@ -207,7 +216,44 @@ fn distinct_primitives(spheres: &[Sphere], quads: &[Quad], triangles: &[Triangle
 /// subtree is rebuilt by median splits, which stop at a leaf when the primitives' centroids
 /// coincide. Errors name what is over a limit: more primitives than references can hold.
 pub fn build(spheres: &[Sphere], quads: &[Quad], triangles: &[Triangle]) -> Result<Bvh, String> {
-    build_over(spheres, quads, triangles, true)
+    build_over(spheres, quads, triangles, &[], true)
+}
+
+/// The two-level structure's top: [`build`] over the spheres, quads and triangles placed as
+/// they are and the instances, given by their boxes in the scene's coordinates (referenced as
+/// `PRIMITIVE_INSTANCE`, after the triangles, each by index; every instance is kept, copies
+/// too, since coincident instances are for the closest-hit rule to order).
+pub fn build_top_level(
+    spheres: &[Sphere],
+    quads: &[Quad],
+    triangles: &[Triangle],
+    instances: &[(Vec3, Vec3)],
+) -> Result<Bvh, String> {
+    build_over(spheres, quads, triangles, instances, true)
+}
+
+/// Builds the bottom level of an instanced mesh, whose triangles are
+/// `all_triangles[first_triangle..][..triangles.len()]`, and lays it out after `tree`'s nodes
+/// and primitives (its node indices and references made absolute), so one node array and one
+/// reference array serve both levels. Returns its root's node index.
+pub fn append_bottom_level(
+    tree: &mut Bvh,
+    triangles: &[Triangle],
+    first_triangle: u32,
+) -> Result<u32, String> {
+    let mesh = build(&[], &[], triangles)?;
+    let root = tree.nodes.len() as u32;
+    let first_primitive = tree.primitives.len() as u32;
+    tree.nodes.extend(mesh.nodes.iter().map(|n| BvhNode {
+        first: n.first + if n.count == 0 { root } else { first_primitive },
+        ..*n
+    }));
+    // Triangle references: the kind stays, the index moves to the mesh's place.
+    tree.primitives
+        .extend(mesh.primitives.iter().map(|&r| r + first_triangle));
+    tree.depth = tree.depth.max(mesh.depth);
+    tree.build_seconds += mesh.build_seconds;
+    Ok(root)
 }
 
 /// [`build`] with every primitive in the tree, exact copies too: what tests of the traversal
@@ -217,25 +263,29 @@ pub fn build_with_copies(
     quads: &[Quad],
     triangles: &[Triangle],
 ) -> Result<Bvh, String> {
-    build_over(spheres, quads, triangles, false)
+    build_over(spheres, quads, triangles, &[], false)
 }
 
 fn build_over(
     spheres: &[Sphere],
     quads: &[Quad],
     triangles: &[Triangle],
+    instances: &[(Vec3, Vec3)],
     without_copies: bool,
 ) -> Result<Bvh, String> {
     let start = Instant::now();
-    let count = spheres.len() + quads.len() + triangles.len();
+    let count = spheres.len() + quads.len() + triangles.len() + instances.len();
     if count > MAX_PRIMITIVES {
         return Err(format!(
             "{count} primitives are more than the BVH can reference (at most {MAX_PRIMITIVES})"
         ));
     }
-    let all_boxes = primitive_boxes(spheres, quads, triangles);
+    let all_boxes = primitive_boxes(spheres, quads, triangles, instances);
     let kept = if without_copies {
-        distinct_primitives(spheres, quads, triangles)
+        let mut kept = distinct_primitives(spheres, quads, triangles);
+        let first_instance = spheres.len() + quads.len() + triangles.len();
+        kept.extend((first_instance..count).map(|i| i as u32));
+        kept
     } else {
         (0..count as u32).collect()
     };
@@ -247,7 +297,14 @@ fn build_over(
     let mut core_time = Duration::ZERO;
     let tree = build_bvh2(&boxes, BvhBuildParams::medium_build(), &mut core_time);
     let levels = subtree_levels(&tree);
-    let reference_of = |p: u32| reference(kept[p as usize] as usize, spheres.len(), quads.len());
+    let reference_of = |p: u32| {
+        reference(
+            kept[p as usize] as usize,
+            spheres.len(),
+            quads.len(),
+            triangles.len(),
+        )
+    };
     // Re-laid out breadth first, each inner node's two children side by side: the layout the
     // kernel reads, independent of how the builder stores its nodes.
     let mut nodes: Vec<BvhNode> = Vec::with_capacity(tree.nodes.len());
@@ -424,6 +481,6 @@ mod tests {
         let tree = build(&spheres, &[], &[]).unwrap();
         let mut kept = tree.primitives.clone();
         kept.sort_unstable();
-        assert_eq!(kept, [0, 1, 2].map(|i| reference(i, spheres.len(), 0)));
+        assert_eq!(kept, [0, 1, 2].map(|i| reference(i, spheres.len(), 0, 0)));
     }
 }

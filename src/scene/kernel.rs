@@ -16,6 +16,51 @@ use crate::shader_types::{
 };
 use glam::{Vec2, Vec3, Vec4};
 
+/// An instance's transforms as the kernel reads them: `placement`'s rows, and its inverse's,
+/// inverted in f64 so the two agree to f32's precision.
+fn kernel_instance(
+    placement: &glam::Mat4,
+    first_triangle: u32,
+    count: u32,
+) -> shader_types::Instance {
+    let inverse = placement.as_dmat4().inverse().as_mat4();
+    let rows = |m: &glam::Mat4| [0, 1, 2].map(|i| m.row(i).to_array());
+    shader_types::Instance {
+        to_world: rows(placement),
+        to_object: rows(&inverse),
+        blas_root: 0,
+        first_triangle,
+        triangle_count: count,
+        _pad: 0,
+    }
+}
+
+/// The box, in the scene's coordinates, of a mesh whose own box is (low, high) placed by
+/// `placement`: its eight corners placed, and widened a little, since a ray is tested against
+/// the mesh in the mesh's coordinates, so a hit on the box's boundary may round to just
+/// outside the exact placed box (a larger box costs a little time, never a hit).
+fn placed_box(placement: &glam::Mat4, low: Vec3, high: Vec3) -> (Vec3, Vec3) {
+    let m = placement.as_dmat4();
+    let (mut min, mut max) = (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY);
+    for corner in 0..8 {
+        let pick = |bit: usize, axis: usize| {
+            if corner & bit != 0 {
+                high[axis]
+            } else {
+                low[axis]
+            }
+        };
+        let p = m.transform_point3(glam::DVec3::new(
+            pick(1, 0) as f64,
+            pick(2, 1) as f64,
+            pick(4, 2) as f64,
+        ));
+        (min, max) = (min.min(p), max.max(p));
+    }
+    let margin = 1e-5 * ((max - min).max_element() + min.abs().max(max.abs()).max_element());
+    ((min - margin).as_vec3(), (max + margin).as_vec3())
+}
+
 /// The scene as the kernel reads it; the CPU reference traces from the same structs.
 #[derive(Clone, Debug)]
 pub struct KernelScene {
@@ -50,6 +95,10 @@ pub struct KernelScene {
     /// Point, spot and directional lights (`scene::light`); point lights with a radius are
     /// spheres instead.
     pub lights: Vec<shader_types::Light>,
+    /// The placements of instanced meshes (`Scene::instanced`), whose triangles follow the
+    /// scene's own in `triangles` and whose bottom-level BVHs follow the top level in
+    /// `bvh_nodes`; empty without instances.
+    pub instances: Vec<shader_types::Instance>,
 }
 
 impl KernelScene {
@@ -75,6 +124,7 @@ impl KernelScene {
             + bytes(&self.environment_texels)
             + bytes(&self.environment_alias)
             + bytes(&self.lights)
+            + bytes(&self.instances)
     }
 }
 
@@ -149,6 +199,14 @@ impl Scene {
 
     fn lay_out(&self) -> Result<KernelScene, InputError> {
         let r = &self.render;
+        // Every triangle the kernel holds: the scene's own, then each instanced mesh's once, in
+        // its own coordinates. Per-triangle arrays are indexed alike; instanced meshes never
+        // emit (validate/objects.rs), so light sampling reads only the first part.
+        let stored: Vec<&super::Triangle> = self
+            .triangles
+            .iter()
+            .chain(self.instanced.iter().flat_map(|m| &m.triangles))
+            .collect();
         let environment = self.environment.as_ref().map(|e| (e, e.tables()));
         let EmitterTable {
             emitters,
@@ -181,6 +239,7 @@ impl Scene {
             accumulated_samples: 0,
             aovs: 0,
             radiance_clamp: 0.0,
+            // The scan's: the triangles placed as they are (instanced ones follow them).
             triangle_count: self.triangles.len() as u32,
             environment_width: environment.as_ref().map_or(0, |(e, _)| e.image.width),
             environment_height: environment.as_ref().map_or(0, |(e, _)| e.image.height),
@@ -312,8 +371,7 @@ impl Scene {
                 }
             })
             .collect();
-        let triangles: Vec<shader_types::Triangle> = self
-            .triangles
+        let triangles: Vec<shader_types::Triangle> = stored
             .iter()
             .enumerate()
             .map(|(i, t)| {
@@ -322,14 +380,13 @@ impl Scene {
                     v0: a.into(),
                     material: t.material,
                     v1: b.into(),
-                    light_probability: triangle_light_probability[i],
+                    light_probability: triangle_light_probability.get(i).copied().unwrap_or(0.0),
                     v2: c.into(),
                     area: 0.5 * (b - a).cross(c - a).length(),
                 }
             })
             .collect();
-        let triangle_normals = self
-            .triangles
+        let triangle_normals = stored
             .iter()
             .map(|t| match t.normals {
                 Some([n0, n1, n2]) => TriangleNormals {
@@ -358,7 +415,7 @@ impl Scene {
             triangle_uvs: if self.textures.is_empty() {
                 Vec::new()
             } else {
-                self.triangles
+                stored
                     .iter()
                     .map(|t| {
                         let [uv0, uv1, uv2] = t.uvs.unwrap_or_default().map(|uv| uv.into());
@@ -367,7 +424,7 @@ impl Scene {
                     .collect()
             },
             triangle_uvs1: if self.textures.descriptors.iter().any(|t| t.uv_set == 1) {
-                self.triangles
+                stored
                     .iter()
                     .map(|t| {
                         let [uv0, uv1, uv2] = t.uvs1.unwrap_or_default().map(|uv| uv.into());
@@ -378,7 +435,7 @@ impl Scene {
                 Vec::new()
             },
             triangle_tangents: if self.materials.iter().any(|m| m.has_normal_map()) {
-                self.triangles
+                stored
                     .iter()
                     .map(|t| {
                         let [t0, t1, t2] = t.tangents.unwrap_or_default().map(|t| t.into());
@@ -389,8 +446,8 @@ impl Scene {
                 Vec::new()
             },
             // White where a triangle has none: the colours multiply.
-            triangle_colors: if self.triangles.iter().any(|t| t.colors.is_some()) {
-                self.triangles
+            triangle_colors: if stored.iter().any(|t| t.colors.is_some()) {
+                stored
                     .iter()
                     .map(|t| {
                         let [c0, c1, c2] = t.colors.unwrap_or([Vec4::ONE; 3]).map(|c| c.into());
@@ -408,6 +465,7 @@ impl Scene {
                 .zip(light_probability)
                 .map(|(l, p)| l.kernel_light(p))
                 .collect(),
+            instances: Vec::new(),
         };
         if let Some((_, tables)) = environment {
             scene.environment_texels = tables.texels;
@@ -420,13 +478,66 @@ impl Scene {
         ) {
             // Validation bounds the primitive count far below what a reference holds, and the
             // builder bounds the tree's depth by the traversal stack: this error is a backstop.
-            let tree = bvh::build(&scene.spheres, &scene.quads, &scene.triangles)
-                .map_err(|e| InputError(format!("the scene cannot be rendered: {e}")))?;
+            let cannot = |e: String| InputError(format!("the scene cannot be rendered: {e}"));
+            let tree = if self.instanced.is_empty() {
+                bvh::build(&scene.spheres, &scene.quads, &scene.triangles).map_err(cannot)?
+            } else {
+                let (tree, instances) = self.two_level(&scene).map_err(cannot)?;
+                scene.instances = instances;
+                tree
+            };
             scene.bvh_nodes = tree.nodes;
             scene.bvh_primitives = tree.primitives;
             scene.bvh_build_seconds = tree.build_seconds;
         }
         Ok(scene)
+    }
+
+    /// The two-level structure over `scene`'s primitives (laid out by [`Scene::lay_out`]): the
+    /// top-level BVH over the spheres, quads and triangles placed as they are and one leaf
+    /// primitive per instance, then each instanced mesh's own BVH after it in the same
+    /// arrays, and the instances' transforms. Memory grows with unique geometry: a mesh's
+    /// triangles and BVH are stored once, whatever its number of instances.
+    fn two_level(
+        &self,
+        scene: &KernelScene,
+    ) -> Result<(bvh::Bvh, Vec<shader_types::Instance>), String> {
+        let own = self.triangles.len();
+        let mut first_triangle = own as u32;
+        let mut instances = Vec::new();
+        let mut boxes = Vec::new();
+        // Each mesh's bottom level is built now and appended once the top level is laid out.
+        let mut meshes = Vec::with_capacity(self.instanced.len());
+        for mesh in &self.instanced {
+            let count = mesh.triangles.len();
+            let range = first_triangle as usize..first_triangle as usize + count;
+            let bottom = bvh::build(&[], &[], &scene.triangles[range.clone()])?;
+            let root = &bottom.nodes[0];
+            let (low, high) = (Vec3::from(root.min), Vec3::from(root.max));
+            for placement in &mesh.placements {
+                boxes.push(placed_box(placement, low, high));
+                instances.push(kernel_instance(placement, first_triangle, count as u32));
+            }
+            meshes.push((
+                instances.len() - mesh.placements.len()..instances.len(),
+                range,
+            ));
+            first_triangle += count as u32;
+        }
+        let mut tree = bvh::build_top_level(
+            &scene.spheres,
+            &scene.quads,
+            &scene.triangles[..own],
+            &boxes,
+        )?;
+        for (placed, range) in meshes {
+            let first = range.start as u32;
+            let root = bvh::append_bottom_level(&mut tree, &scene.triangles[range], first)?;
+            for instance in &mut instances[placed] {
+                instance.blas_root = root;
+            }
+        }
+        Ok((tree, instances))
     }
 
     /// Every emitting primitive with its selection probability, proportional to its power
@@ -509,6 +620,30 @@ impl Scene {
                     ]
                 }))
                 .chain(self.triangles.iter().flat_map(|t| t.vertices))
+                // An instanced mesh's placed box, not its placed vertices, which may be 10¹⁰:
+                // a bound a little larger than the flattened scene's.
+                .chain(self.instanced.iter().flat_map(|m| {
+                    let low = m
+                        .triangles
+                        .iter()
+                        .flat_map(|t| t.vertices)
+                        .fold(Vec3::INFINITY, Vec3::min);
+                    let high = m
+                        .triangles
+                        .iter()
+                        .flat_map(|t| t.vertices)
+                        .fold(Vec3::NEG_INFINITY, Vec3::max);
+                    m.placements.iter().flat_map(move |p| {
+                        (0..8).map(move |c| {
+                            let corner = Vec3::select(
+                                glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0),
+                                high,
+                                low,
+                            );
+                            p.transform_point3(corner)
+                        })
+                    })
+                }))
                 .chain(self.lights.iter().filter_map(|l| match l.kind {
                     LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
                         Some(position)

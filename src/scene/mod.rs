@@ -79,14 +79,55 @@ pub struct Scene {
     pub materials: Vec<Material>,
     pub spheres: Vec<Sphere>,
     pub quads: Vec<Quad>,
-    /// Every mesh's triangles, in the scene's coordinates.
+    /// Every mesh's triangles, in the scene's coordinates, but those of instanced meshes.
     pub triangles: Vec<Triangle>,
+    /// Meshes placed many times without copies (`[[meshes]] instances`, see
+    /// [`InstancedMesh`]); their triangles are not in `triangles`.
+    pub instanced: Vec<InstancedMesh>,
     /// The textures materials refer to.
     pub textures: texture::TextureSet,
     /// `[environment]`: lights the scene in place of `render.background`.
     pub environment: Option<environment::Environment>,
     /// `[[lights]]`: point, spot and directional lights.
     pub lights: Vec<light::Light>,
+}
+
+/// A mesh placed many times and stored once: the two-level structure's bottom level
+/// (src/scene/kernel.rs lays it out, shaders/traverse/blas.wgsl traces it). Its triangles are
+/// in the mesh's own coordinates (its `[[meshes]]` transform applied), and each placement
+/// takes them to the scene's. Only opaque meshes that do not emit and have no normal map are
+/// held so (`validate/objects.rs` says why); others are flattened into [`Scene::triangles`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstancedMesh {
+    pub triangles: Vec<Triangle>,
+    pub placements: Vec<glam::Mat4>,
+}
+
+impl Scene {
+    /// The same scene with every instanced mesh copied into `triangles`, placement after
+    /// placement, after the scene's own triangles: what the two-level structure must render
+    /// the same as (tests/instancing.rs).
+    pub fn flattened(&self) -> Scene {
+        let mut scene = self.clone();
+        for mesh in std::mem::take(&mut scene.instanced) {
+            for placement in &mesh.placements {
+                scene
+                    .triangles
+                    .extend(mesh.triangles.iter().map(|t| mesh::placed(t, placement)));
+            }
+        }
+        scene
+    }
+
+    /// Triangles the scene places: its own and every instance's.
+    pub fn placed_triangle_count(&self) -> u64 {
+        let instanced: u64 = self
+            .instanced
+            .iter()
+            .map(|m| m.triangles.len() as u64 * m.placements.len() as u64)
+            .sum();
+        self.triangles.len() as u64 + instanced
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -215,6 +215,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
         spheres: Vec::new(),
         quads: Vec::new(),
         triangles,
+        instanced: Vec::new(),
         textures,
         environment: Some(environment),
         lights,

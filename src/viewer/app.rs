@@ -321,8 +321,9 @@ impl App {
             view_formats: vec![],
         };
         surface.configure(&ctx.device, &config);
-        let traversal = self.options.traversal.resolve(ctx)?;
-        let renderer = GpuRenderer::with_traversal(ctx, &self.kernel_scene(), traversal)?;
+        let kernel_scene = self.kernel_scene();
+        let traversal = self.options.traversal.resolve_for(ctx, &kernel_scene)?;
+        let renderer = GpuRenderer::with_traversal(ctx, &kernel_scene, traversal)?;
         let mut display = DisplayPass::new(&ctx.device, format);
         display.bind(&ctx.device, renderer.mean_buffer());
         crate::errln!(

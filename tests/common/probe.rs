@@ -133,6 +133,7 @@ fn run_probe_with(
     let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
     let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
     let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
+    let instances = storage_buffer(ctx, "instances", &scene.instances);
     let textures = storage_buffer(ctx, "textures", &scene.textures);
     let texels = storage_buffer(ctx, "texels", &scene.texels);
     let triangle_uvs = storage_buffer(ctx, "triangle uvs", &scene.triangle_uvs);
@@ -187,6 +188,7 @@ fn run_probe_with(
             (12, read_only, &bvh_nodes),
             (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
             (13, read_only, &bvh_primitives),
+            (40, read_only, &instances),
             (10, wgpu::BufferBindingType::Uniform, &probe_params),
             (11, read_write, &out),
             (20, read_only, &textures),

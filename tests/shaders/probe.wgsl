@@ -208,13 +208,18 @@ fn probe_closest_hit(@builtin(global_invocation_id) id: vec3<u32>) {
     let found = closest_primitive(ray);
     let expected = scan_closest_primitive(ray);
     var flags = 0u;
-    if expected.t != NO_HIT && first_hit_is(ray, expected.primitive, expected.index) {
+    // A shadow ray's target is never a triangle hit through an instance (no light is one):
+    // there the instance is compared instead, 8 flagging a different one.
+    if expected.t != NO_HIT && (expected.instance != NO_INSTANCE || first_hit_is(ray, expected.primitive, expected.index)) {
         flags |= 1u;
+    }
+    if found.instance != expected.instance {
+        flags |= 8u;
     }
     let kind_count = select(select(triangle_count(), quad_count(), expected.primitive == PRIMITIVE_QUAD), sphere_count(), expected.primitive == PRIMITIVE_SPHERE);
     let stride = u32(probe.normal[min(expected.primitive, 2u)]);
     let next = expected.index + stride;
-    if expected.t != NO_HIT && next < kind_count && first_hit_is(ray, expected.primitive, next) {
+    if expected.t != NO_HIT && expected.instance == NO_INSTANCE && next < kind_count && first_hit_is(ray, expected.primitive, next) {
         flags |= 2u;
     }
     if escapes(ray) {

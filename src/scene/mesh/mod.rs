@@ -39,6 +39,24 @@ pub const MAX_TRIANGLES: usize = 1 << 28;
 /// for far more memory than any mesh file could.
 pub const MAX_PLACED_TRIANGLES: usize = 1 << 25;
 
+/// Triangle `t` moved by `matrix`: its vertices, its normals through the inverse transpose of
+/// the linear part (renormalised), its tangents through the linear part, as [`load_placed`]
+/// places a file's triangles.
+pub fn placed(t: &Triangle, matrix: &Mat4) -> Triangle {
+    let linear = Mat3::from_mat4(*matrix);
+    let normal_matrix = linear.inverse().transpose();
+    Triangle {
+        vertices: t.vertices.map(|v| matrix.transform_point3(v)),
+        normals: t
+            .normals
+            .map(|n| n.map(|n| (normal_matrix * n).normalize_or_zero())),
+        tangents: t
+            .tangents
+            .map(|c| c.map(|tangent| tangents::placed_tangent(&linear, tangent))),
+        ..t.clone()
+    }
+}
+
 /// Whether `path` names a glTF file (`.gltf`, `.glb`), by its extension.
 pub fn is_gltf(path: &Path) -> bool {
     path.extension()

@@ -118,6 +118,7 @@ impl SceneToml {
             spheres: objects.spheres,
             quads: objects.quads,
             triangles: objects.triangles,
+            instanced: objects.instanced,
             textures,
             environment,
             lights: {

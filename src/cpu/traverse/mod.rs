@@ -1,0 +1,3 @@
+//! Traversal structures beyond the top-level BVH (WGSL side: `shaders/traverse/`).
+
+pub mod blas;
