@@ -10,8 +10,8 @@ use super::triangle::{
 };
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, PRIMITIVE_ENVIRONMENT,
-    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, BvhWideNode, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -25,6 +25,9 @@ pub struct Geometry<'a> {
     pub triangle_normals: &'a [TriangleNormals],
     pub bvh_nodes: &'a [BvhNode],
     pub bvh_primitives: &'a [u32],
+    /// The same tree 4 wide, traversed instead of `bvh_nodes` when not empty (the CPU's
+    /// layout: src/scene/bvh_layout.rs).
+    pub bvh_wide_nodes: &'a [BvhWideNode],
     /// One per triangle when `textured`.
     pub triangle_uvs: &'a [TriangleUvs],
     /// The second set, where a texture reads it (else empty).

@@ -32,6 +32,7 @@ pub mod sheen_energy;
 pub mod surface;
 pub mod texture;
 pub mod trace;
+pub mod traverse;
 pub mod triangle;
 pub mod vertex_color;
 pub mod volume;

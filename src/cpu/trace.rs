@@ -18,12 +18,13 @@ use super::texture::{material_at, Textures};
 use super::vertex_color::vertex_colored;
 use super::volume::volume_transmittance;
 use super::Ray;
+use crate::scene::bvh_layout::BvhLayout;
 use crate::scene::KernelScene;
 use crate::shader::has_alpha;
 use crate::shader_types::{
-    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Quad, Sphere,
-    Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs, NO_TEXTURE,
-    PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
+    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params,
+    Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
+    TriangleUvs, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -40,6 +41,8 @@ pub struct SceneRefs<'a> {
     /// Empty: every ray tests every primitive.
     pub bvh_nodes: &'a [BvhNode],
     pub bvh_primitives: &'a [u32],
+    /// The 4-wide tree where the CPU traverses it (src/scene/bvh_layout.rs), else empty.
+    pub bvh_wide_nodes: &'a [BvhWideNode],
     /// Texture descriptors and texels (`texture.rs`); empty without textures.
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
@@ -76,6 +79,10 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: &scene.triangle_normals,
             bvh_nodes: &scene.bvh_nodes,
             bvh_primitives: &scene.bvh_primitives,
+            bvh_wide_nodes: match BvhLayout::for_cpu() {
+                BvhLayout::Wide => &scene.bvh_wide_nodes,
+                BvhLayout::Binary => &[],
+            },
             environment_texels: &scene.environment_texels,
             environment_alias: &scene.environment_alias,
             textures: &scene.textures,
@@ -115,6 +122,7 @@ impl<'a> SceneRefs<'a> {
             triangle_normals: self.triangle_normals,
             bvh_nodes: self.bvh_nodes,
             bvh_primitives: self.bvh_primitives,
+            bvh_wide_nodes: self.bvh_wide_nodes,
             triangle_uvs: self.triangle_uvs,
             triangle_uvs1: self.triangle_uvs1,
             textured: !self.textures.is_empty(),
