@@ -188,7 +188,11 @@ impl SceneBinding {
     /// The fast uniform binding when every array fits in `max_uniform_binding` bytes (the
     /// device's limit) and in [`MAX_UNIFORM_SCENE_BYTES`], storage buffers otherwise.
     pub fn for_scene(scene: &KernelScene, max_uniform_binding: u64) -> SceneBinding {
-        if !scene.bvh_wide_nodes.is_empty() && BvhLayout::for_gpu() == BvhLayout::Wide {
+        // A scene without the binary tree is scanned, as on the CPU, whatever else it holds.
+        if !scene.bvh_nodes.is_empty()
+            && !scene.bvh_wide_nodes.is_empty()
+            && BvhLayout::for_gpu() == BvhLayout::Wide
+        {
             return SceneBinding::WideBvh {
                 uniform_nodes: bvh_wide_uniform_nodes(max_uniform_binding),
                 stack_size: crate::scene::bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes),
