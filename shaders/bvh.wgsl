@@ -109,6 +109,10 @@ fn primitive_box_entry(reference: u32, r: BvhRay) -> f32 {
 const NO_PRIMITIVE: u32 = 0xffffffffu;
 
 fn bvh_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
+    // The wide tree in the wide variant (the GPU's layout: src/scene/bvh_layout.rs).
+    if BVH_WIDE {
+        return wide_traverse(r, t_max, t_prune, max_reference, shadow_target);
+    }
     var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
     var best_reference = max_reference;
     var prune = t_prune;

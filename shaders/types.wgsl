@@ -190,6 +190,22 @@ struct BvhNode {
     count: u32,
 }
 
+// A node of the 4-wide BVH (src/scene/bvh_wide.rs): its up to four children's boxes, one axis
+// bound per vector, and what each child is: an inner node at bvh_wide_nodes[first] (count == 0),
+// a leaf holding bvh_primitives[first .. first + count], or none (count == WIDE_EMPTY_CHILD).
+struct BvhWideNode {
+    min_x: vec4<f32>,
+    min_y: vec4<f32>,
+    min_z: vec4<f32>,
+    max_x: vec4<f32>,
+    max_y: vec4<f32>,
+    max_z: vec4<f32>,
+    first: vec4<u32>,
+    count: vec4<u32>,
+}
+
+const WIDE_EMPTY_CHILD: u32 = 0xffffffffu;
+
 // A BVH leaf's primitive reference: the kind in the top two bits, the index below.
 const PRIMITIVE_KIND_SHIFT: u32 = 30u;
 const PRIMITIVE_INDEX_MASK: u32 = 0x3fffffffu;

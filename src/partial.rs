@@ -74,6 +74,7 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         triangle_normals,
         bvh_nodes: _,
         bvh_primitives: _,
+        bvh_wide_nodes: _,
         bvh_build_seconds: _,
         textures,
         texels,

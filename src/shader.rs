@@ -1,10 +1,11 @@
 //! The WGSL kernel, assembled from one file per concept in `shaders/` (WGSL has no includes).
 
+use crate::scene::bvh_layout::BvhLayout;
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    BvhNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, LIGHT_SUN, MATERIAL_DIELECTRIC,
-    MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
-    PRIMITIVE_TRIANGLE,
+    BvhNode, BvhWideNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, LIGHT_SUN,
+    MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use crate::texel_windows::TexelBinding;
 
@@ -90,6 +91,10 @@ const SCENE_STORAGE: &str = include_str!("../shaders/scene_storage.wgsl");
 const TRAVERSE_HARDWARE: &str = include_str!("../shaders/traverse/hardware.wgsl");
 /// Its entry points as stubs, in every other variant.
 const TRAVERSE_SOFTWARE_ONLY: &str = include_str!("../shaders/traverse/software_only.wgsl");
+/// The 4-wide BVH's traversal, in the wide variant only.
+const TRAVERSE_WIDE: &str = include_str!("../shaders/traverse/wide.wgsl");
+/// Its entry point as a stub, in every other variant.
+const TRAVERSE_BINARY_ONLY: &str = include_str!("../shaders/traverse/binary_only.wgsl");
 const SCENE_UNIFORM: &str = include_str!("../shaders/scene_uniform.wgsl");
 
 /// Name of the compute entry point in `shaders/trace.wgsl`.
@@ -113,6 +118,11 @@ pub enum SceneBinding {
     /// traversal stack holds `stack_size` entries: enough for the tree
     /// ([`crate::scene::bvh::kernel_stack_size`]).
     Bvh { uniform_nodes: u32, stack_size: u32 },
+    /// The same, traversing the 4-wide tree ([`KernelScene::bvh_wide_nodes`],
+    /// `shaders/traverse/wide.wgsl`) where the GPU's layout is wide
+    /// ([`crate::scene::bvh_layout`]): `uniform_nodes` of its top in a uniform buffer, a stack of
+    /// `stack_size` entries ([`crate::scene::bvh_wide::kernel_stack_size`]).
+    WideBvh { uniform_nodes: u32, stack_size: u32 },
     /// Storage buffers traced with the device's ray queries
     /// (`shaders/traverse/hardware.wgsl`) against an acceleration structure the host builds
     /// (`src/gpu/acceleration.rs`): only on devices with `wgpu::Features::EXPERIMENTAL_RAY_QUERY`,
@@ -131,6 +141,13 @@ pub enum SceneBinding {
 pub fn bvh_uniform_nodes(max_uniform_binding: u64) -> u32 {
     let bytes = max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES);
     (bytes / size_of::<BvhNode>() as u64).max(1) as u32
+}
+
+/// [`bvh_uniform_nodes`] for the wide tree's nodes (512 on lavapipe and NVIDIA: the top 4½
+/// levels).
+pub fn bvh_wide_uniform_nodes(max_uniform_binding: u64) -> u32 {
+    let bytes = max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES);
+    (bytes / size_of::<BvhWideNode>() as u64).max(1) as u32
 }
 
 /// How many of each object a scene has.
@@ -176,6 +193,16 @@ impl SceneBinding {
     /// The fast uniform binding when every array fits in `max_uniform_binding` bytes (the
     /// device's limit) and in [`MAX_UNIFORM_SCENE_BYTES`], storage buffers otherwise.
     pub fn for_scene(scene: &KernelScene, max_uniform_binding: u64) -> SceneBinding {
+        // A scene without the binary tree is scanned, as on the CPU, whatever else it holds.
+        if !scene.bvh_nodes.is_empty()
+            && !scene.bvh_wide_nodes.is_empty()
+            && BvhLayout::for_gpu() == BvhLayout::Wide
+        {
+            return SceneBinding::WideBvh {
+                uniform_nodes: bvh_wide_uniform_nodes(max_uniform_binding),
+                stack_size: crate::scene::bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes),
+            };
+        }
         if !scene.bvh_nodes.is_empty() {
             return SceneBinding::Bvh {
                 uniform_nodes: bvh_uniform_nodes(max_uniform_binding),
@@ -195,7 +222,10 @@ impl SceneBinding {
     pub fn uniform_node_count(&self) -> u32 {
         match self {
             SceneBinding::Bvh { uniform_nodes, .. } => *uniform_nodes,
-            SceneBinding::Storage | SceneBinding::Uniform(_) | SceneBinding::Hardware => 1,
+            SceneBinding::Storage
+            | SceneBinding::Uniform(_)
+            | SceneBinding::Hardware
+            | SceneBinding::WideBvh { .. } => 1,
         }
     }
 
@@ -204,7 +234,22 @@ impl SceneBinding {
     pub fn stack_size(&self) -> u32 {
         match self {
             SceneBinding::Bvh { stack_size, .. } => *stack_size,
-            SceneBinding::Storage | SceneBinding::Uniform(_) | SceneBinding::Hardware => 1,
+            SceneBinding::Storage
+            | SceneBinding::Uniform(_)
+            | SceneBinding::Hardware
+            | SceneBinding::WideBvh { .. } => 1,
+        }
+    }
+
+    /// The wide traversal's uniform node count and stack length (`BVH_WIDE_UNIFORM_NODES`,
+    /// `BVH_WIDE_STACK_SIZE`): one each, unused, in the other layouts.
+    pub fn wide_sizes(&self) -> (u32, u32) {
+        match self {
+            SceneBinding::WideBvh {
+                uniform_nodes,
+                stack_size,
+            } => (*uniform_nodes, *stack_size),
+            _ => (1, 1),
         }
     }
 
@@ -214,6 +259,7 @@ impl SceneBinding {
             SceneBinding::Storage => "storage",
             SceneBinding::Uniform(_) => "uniform",
             SceneBinding::Bvh { .. } => "bvh",
+            SceneBinding::WideBvh { .. } => "bvh-wide",
             SceneBinding::Hardware => "hardware",
         }
     }
@@ -227,10 +273,19 @@ impl SceneBinding {
     fn part(&self) -> (&'static str, String) {
         // Triangles exist only in the storage layouts; the uniform one compiles their code out.
         // The BVH's constants are declared in every layout, since bvh.wgsl is always compiled.
+        let (wide_nodes, wide_stack) = self.wide_sizes();
+        let wide = matches!(self, SceneBinding::WideBvh { .. });
         let bvh = format!(
-            "const BVH_UNIFORM_NODES: u32 = {}u;\nconst BVH_STACK_SIZE: u32 = {}u;\n",
+            "const BVH_UNIFORM_NODES: u32 = {}u;\nconst BVH_STACK_SIZE: u32 = {}u;\n\
+             const BVH_WIDE: bool = {wide};\nconst BVH_WIDE_UNIFORM_NODES: u32 = {wide_nodes}u;\n\
+             const BVH_WIDE_STACK_SIZE: u32 = {wide_stack}u;\n{}",
             self.uniform_node_count(),
-            self.stack_size()
+            self.stack_size(),
+            if wide {
+                TRAVERSE_WIDE
+            } else {
+                TRAVERSE_BINARY_ONLY
+            }
         );
         // The traversal's entry points: ray queries in the hardware variant, stubs elsewhere.
         let hardware = self.uses_ray_queries();
@@ -250,7 +305,9 @@ impl SceneBinding {
         };
         match self {
             SceneBinding::Storage => ("scene_storage.wgsl", storage(false)),
-            SceneBinding::Bvh { .. } => ("scene_storage.wgsl", storage(true)),
+            SceneBinding::Bvh { .. } | SceneBinding::WideBvh { .. } => {
+                ("scene_storage.wgsl", storage(true))
+            }
             SceneBinding::Hardware => ("scene_storage.wgsl", storage(false)),
             SceneBinding::Uniform(c) => (
                 "scene_uniform.wgsl",

@@ -241,6 +241,26 @@ pub struct BvhNode {
     pub count: u32,
 }
 
+/// A node of the 4-wide BVH (`src/scene/bvh_wide.rs`): its up to four children's boxes, one
+/// axis bound per vector (the box test runs on all four at once), and what each child is: an
+/// inner node at `bvh_wide_nodes[first]` (`count == 0`), a leaf holding
+/// `bvh_primitives[first .. first + count]`, or no child (`count == WIDE_EMPTY_CHILD`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BvhWideNode {
+    pub min_x: [f32; 4],
+    pub min_y: [f32; 4],
+    pub min_z: [f32; 4],
+    pub max_x: [f32; 4],
+    pub max_y: [f32; 4],
+    pub max_z: [f32; 4],
+    pub first: [u32; 4],
+    pub count: [u32; 4],
+}
+
+/// A [`BvhWideNode`]'s `count` for a slot that holds no child.
+pub const WIDE_EMPTY_CHILD: u32 = u32::MAX;
+
 /// A BVH leaf's primitive reference: the kind in the top two bits, the index below.
 pub const PRIMITIVE_KIND_SHIFT: u32 = 30;
 pub const PRIMITIVE_INDEX_MASK: u32 = (1 << PRIMITIVE_KIND_SHIFT) - 1;

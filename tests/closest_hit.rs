@@ -6,7 +6,7 @@
 //! coincident copies of spheres, quads and triangles, where only the rule decides the hit.
 
 mod common;
-use common::probe::{run_probe_bvh, run_probe_hardware, ProbeParams};
+use common::probe::{run_probe_bvh, run_probe_bvh_wide, run_probe_hardware, ProbeParams};
 use common::{gpu, gpu_with_ray_queries};
 use glam::Vec3;
 use glint::cpu::intersect::{
@@ -111,6 +111,7 @@ fn stack_scene(dir: &std::path::Path) -> KernelScene {
 fn with_copies_in_the_tree(scene: &KernelScene) -> KernelScene {
     let tree = bvh::build_with_copies(&scene.spheres, &scene.quads, &scene.triangles).unwrap();
     KernelScene {
+        bvh_wide_nodes: tree.wide_nodes(),
         bvh_nodes: tree.nodes,
         bvh_primitives: tree.primitives,
         ..scene.clone()
@@ -189,11 +190,34 @@ fn check_cpu(
         bvh_primitives: &[],
         ..refs.geometry()
     };
+    fn binary(g: Geometry) -> Geometry {
+        Geometry {
+            bvh_wide_nodes: &[],
+            ..g
+        }
+    }
     let structures = [
-        ("bvh", refs.geometry()),
-        ("bvh with copies", full_refs.geometry()),
+        ("bvh", binary(refs.geometry())),
+        ("bvh with copies", binary(full_refs.geometry())),
+        (
+            "wide bvh",
+            Geometry {
+                bvh_wide_nodes: &scene.bvh_wide_nodes,
+                ..refs.geometry()
+            },
+        ),
+        (
+            "wide bvh with copies",
+            Geometry {
+                bvh_wide_nodes: &full.bvh_wide_nodes,
+                ..full_refs.geometry()
+            },
+        ),
     ];
     assert!(structures.iter().all(|(_, g)| !g.bvh_nodes.is_empty()));
+    assert!(structures[2..]
+        .iter()
+        .all(|(_, g)| !g.bvh_wide_nodes.is_empty()));
     let mut rng = Rng::new(7, 0, 0, 13);
     let (mut hits, mut on_copies) = (0, 0);
     for i in 0..100_000u32 {
@@ -241,15 +265,26 @@ fn check_cpu(
 /// take 7 of CI's minutes; 2.5·10⁴ still meet every stacked and copied primitive many times.
 const GPU_RAYS: u32 = 25_000;
 
-/// The same on the GPU, through the probe kernel (tests/shaders/probe.wgsl): the kernel's BVH
-/// traversal (or with `hardware`, its ray queries: shaders/traverse/hardware.wgsl) and its scan
+/// The GPU traversals [`check_gpu`] runs.
+#[derive(Clone, Copy, Debug)]
+enum GpuTraversal {
+    /// The binary BVH (shaders/bvh.wgsl).
+    Binary,
+    /// The 4-wide BVH (shaders/traverse/wide.wgsl).
+    Wide,
+    /// Ray queries (shaders/traverse/hardware.wgsl).
+    Hardware,
+}
+
+/// The same on the GPU, through the probe kernel (tests/shaders/probe.wgsl): the kernel's
+/// `traversal` and its scan
 /// find the same hit, bit for bit, for [`GPU_RAYS`] rays, and its shadow tests agree (with
 /// `stride` as in [`check_cpu`]). Returns how many rays hit something.
 fn check_gpu(
     ctx: &glint::gpu::GpuContext,
     scene: &KernelScene,
     stride: [u32; 3],
-    hardware: bool,
+    traversal: GpuTraversal,
 ) -> u32 {
     let rays = GPU_RAYS;
     let params = ProbeParams {
@@ -260,11 +295,12 @@ fn check_gpu(
         normal: stride.map(|s| s as f32),
         ..Default::default()
     };
-    let out = if hardware {
-        run_probe_hardware(ctx, "probe_closest_hit", params, scene)
-    } else {
-        run_probe_bvh(ctx, "probe_closest_hit", params, scene)
+    let probe = match traversal {
+        GpuTraversal::Binary => run_probe_bvh,
+        GpuTraversal::Wide => run_probe_bvh_wide,
+        GpuTraversal::Hardware => run_probe_hardware,
     };
+    let out = probe(ctx, "probe_closest_hit", params, scene);
     let mut hits = 0;
     // Every disagreement, so a failure says how many and which rays.
     let mut wrong = Vec::new();
@@ -296,7 +332,7 @@ fn check_gpu(
     }
     assert!(
         wrong.is_empty(),
-        "{} disagreements with the scan in {} rays (hardware: {hardware}), the first: {:#?}",
+        "{} disagreements with the scan in {} rays ({traversal:?}), the first: {:#?}",
         wrong.len(),
         rays,
         &wrong[..wrong.len().min(10)]
@@ -333,8 +369,10 @@ fn every_gpu_traversal_finds_the_lowest_of_coincident_copies() {
     let dir = tempfile::tempdir().unwrap();
     let scene = copies_scene(dir.path());
     for tree in [scene.clone(), with_copies_in_the_tree(&scene)] {
-        let hits = check_gpu(ctx, &tree, COPY_STRIDE, false);
-        assert!(hits > GPU_RAYS / 2, "{hits}");
+        for traversal in [GpuTraversal::Binary, GpuTraversal::Wide] {
+            let hits = check_gpu(ctx, &tree, COPY_STRIDE, traversal);
+            assert!(hits > GPU_RAYS / 2, "{hits}");
+        }
     }
 }
 
@@ -343,8 +381,10 @@ fn every_gpu_traversal_finds_the_closest_of_a_deep_stack() {
     let Some(ctx) = gpu() else { return };
     let dir = tempfile::tempdir().unwrap();
     let scene = stack_scene(dir.path());
-    let hits = check_gpu(ctx, &scene, [1; 3], false);
-    assert!(hits > GPU_RAYS * 3 / 10, "{hits}");
+    for traversal in [GpuTraversal::Binary, GpuTraversal::Wide] {
+        let hits = check_gpu(ctx, &scene, [1; 3], traversal);
+        assert!(hits > GPU_RAYS * 3 / 10, "{hits}");
+    }
 }
 
 /// The hardware traversal (ray queries against a TLAS, every candidate decided by glint's own
@@ -359,7 +399,7 @@ fn hardware_traversal_finds_the_lowest_of_coincident_copies() {
     let dir = tempfile::tempdir().unwrap();
     let scene = copies_scene(dir.path());
     for tree in [scene.clone(), with_copies_in_the_tree(&scene)] {
-        let hits = check_gpu(ctx, &tree, COPY_STRIDE, true);
+        let hits = check_gpu(ctx, &tree, COPY_STRIDE, GpuTraversal::Hardware);
         assert!(hits > GPU_RAYS / 2, "{hits}");
     }
 }
@@ -371,6 +411,6 @@ fn hardware_traversal_finds_the_closest_of_a_deep_stack() {
     };
     let dir = tempfile::tempdir().unwrap();
     let scene = stack_scene(dir.path());
-    let hits = check_gpu(ctx, &scene, [1; 3], true);
+    let hits = check_gpu(ctx, &scene, [1; 3], GpuTraversal::Hardware);
     assert!(hits > GPU_RAYS * 3 / 10, "{hits}");
 }

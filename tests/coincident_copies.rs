@@ -87,6 +87,7 @@ fn with_copies_in_the_tree(scene: &KernelScene) -> KernelScene {
         tree.depth
     );
     KernelScene {
+        bvh_wide_nodes: tree.wide_nodes(),
         bvh_nodes: tree.nodes,
         bvh_primitives: tree.primitives,
         ..scene.clone()

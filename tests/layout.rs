@@ -7,8 +7,9 @@ use glint::shader::{
     WORKGROUP_SIZE,
 };
 use glint::shader_types::{
-    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material, Params, Quad,
-    Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs,
+    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
+    Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
+    TriangleUvs,
 };
 use glint::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use naga::proc::Layouter;
@@ -221,6 +222,12 @@ fn rust_structs_match_wgsl_layout() {
     );
     assert_same_layout!(
         &module,
+        BvhWideNode,
+        "BvhWideNode",
+        [min_x, min_y, min_z, max_x, max_y, max_z, first, count]
+    );
+    assert_same_layout!(
+        &module,
         Light,
         "Light",
         [
@@ -299,6 +306,7 @@ fn material_kind_constants_match() {
         ("ALPHA_OPAQUE", t::ALPHA_OPAQUE),
         ("ALPHA_MASK", t::ALPHA_MASK),
         ("ALPHA_BLEND", t::ALPHA_BLEND),
+        ("WIDE_EMPTY_CHILD", t::WIDE_EMPTY_CHILD),
     ] {
         assert_eq!(constant(name), value, "{name}");
     }
@@ -421,6 +429,10 @@ fn every_feature_combination_validates() {
                 uniform_nodes: 2048,
                 stack_size: 64,
             },
+            SceneBinding::WideBvh {
+                uniform_nodes: 512,
+                stack_size: 200,
+            },
         ] {
             validate_source(render_kernel_source_for(KernelVariant {
                 binding,
@@ -529,6 +541,10 @@ fn texel_windows_are_bound_where_the_host_binds_them() {
         SceneBinding::Bvh {
             uniform_nodes: 2048,
             stack_size: 64,
+        },
+        SceneBinding::WideBvh {
+            uniform_nodes: 512,
+            stack_size: 200,
         },
     ] {
         for textures in [true, false] {

@@ -9,10 +9,12 @@ use glint::gpu::GpuRenderer;
 use glint::output::Image;
 use glint::render::render_image;
 use glint::scene::bvh::kernel_stack_size;
+use glint::scene::bvh_layout::BvhLayout;
+use glint::scene::bvh_wide;
 use glint::scene::KernelScene;
 use glint::shader::{
-    bvh_uniform_nodes, KernelFeatures, KernelVariant, SceneBinding, SceneCounts,
-    MAX_UNIFORM_SCENE_BYTES,
+    bvh_uniform_nodes, bvh_wide_uniform_nodes, KernelFeatures, KernelVariant, SceneBinding,
+    SceneCounts, MAX_UNIFORM_SCENE_BYTES,
 };
 
 fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
@@ -111,7 +113,10 @@ fn large_scene_renders_through_storage_buffers_like_the_cpu() {
     for seed in [1, 2] {
         let scene = tiled_cornell(700, 64, seed);
         let mut renderer = GpuRenderer::new(ctx, &scene).unwrap();
-        assert!(matches!(renderer.scene_binding(), SceneBinding::Bvh { .. }));
+        assert!(matches!(
+            renderer.scene_binding(),
+            SceneBinding::Bvh { .. } | SceneBinding::WideBvh { .. }
+        ));
         let gpu_image = render_image(&mut renderer, 1, 1).unwrap();
         agreement.add(&render_cpu(&scene, 1), &gpu_image);
         let scene = without_bvh(scene);
@@ -130,14 +135,19 @@ fn bvh_top_nodes_fill_the_uniform_limit() {
     assert_eq!(bvh_uniform_nodes(65536), 2048);
     assert_eq!(bvh_uniform_nodes(1 << 30), 2048);
     assert_eq!(bvh_uniform_nodes(16384), 512);
+    assert_eq!(bvh_wide_uniform_nodes(65536), 512);
     let bunny = sized(shipped_scene("bunny.toml"), 8, 0);
-    assert_eq!(
-        SceneBinding::for_scene(&bunny, 65536),
-        SceneBinding::Bvh {
+    let expected = match BvhLayout::for_gpu() {
+        BvhLayout::Binary => SceneBinding::Bvh {
             uniform_nodes: 2048,
             stack_size: kernel_stack_size(&bunny.bvh_nodes),
-        }
-    );
+        },
+        BvhLayout::Wide => SceneBinding::WideBvh {
+            uniform_nodes: 512,
+            stack_size: bvh_wide::kernel_stack_size(&bunny.bvh_wide_nodes),
+        },
+    };
+    assert_eq!(SceneBinding::for_scene(&bunny, 65536), expected);
 }
 
 /// Reading the BVH's top nodes from the uniform copy, for all of a small tree or the top of a
@@ -174,6 +184,28 @@ fn bvh_top_nodes_in_a_uniform_buffer_do_not_change_the_image() {
             let image = render_with(&scene, binding, 2);
             let differing = differing_pixels(&storage_only, &image);
             assert_eq!(differing, 0, "{name} with {uniform_nodes} uniform nodes");
+        }
+        // The same for the wide tree (whose 512 uniform nodes hold all of the bunny's).
+        let wide_stack = bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes);
+        let wide_storage_only = render_with(
+            &scene,
+            SceneBinding::WideBvh {
+                uniform_nodes: 1,
+                stack_size: wide_stack,
+            },
+            2,
+        );
+        for uniform_nodes in [16, 64, 512] {
+            let binding = SceneBinding::WideBvh {
+                uniform_nodes,
+                stack_size: wide_stack,
+            };
+            let image = render_with(&scene, binding, 2);
+            let differing = differing_pixels(&wide_storage_only, &image);
+            assert_eq!(
+                differing, 0,
+                "{name}, wide, with {uniform_nodes} uniform nodes"
+            );
         }
     }
 }

@@ -9,6 +9,7 @@
 use super::alpha::hit_scene_triangle;
 use super::intersect::{hit_comes_first, hit_quad, hit_sphere, ClosestPrimitive, Geometry, NO_HIT};
 use super::traverse::blas::hit_instance;
+use super::traverse::wide::wide_traverse;
 use super::triangle::{triangle_ray, TriangleRay};
 use super::Ray;
 use crate::shader_types::{
@@ -113,6 +114,10 @@ pub fn bvh_traverse(
     max_reference: u32,
     shadow_target: u32,
 ) -> ClosestPrimitive {
+    // The wide tree where the CPU's layout is wide (src/scene/bvh_layout.rs).
+    if !geometry.bvh_wide_nodes.is_empty() {
+        return wide_traverse(geometry, r, t_max, t_prune, max_reference, shadow_target);
+    }
     let nodes = geometry.bvh_nodes;
     let mut best = ClosestPrimitive {
         t: t_max,

@@ -11,8 +11,8 @@ use super::triangle::{
 };
 use super::Ray;
 use crate::shader_types::{
-    BvhNode, Instance, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs, NO_INSTANCE,
-    PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, BvhWideNode, Instance, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs,
+    NO_INSTANCE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -28,6 +28,9 @@ pub struct Geometry<'a> {
     pub bvh_primitives: &'a [u32],
     /// Instanced meshes' placements (`instance.rs`); empty without any.
     pub instances: &'a [Instance],
+    /// The same tree 4 wide, traversed instead of `bvh_nodes` when not empty (the CPU's
+    /// layout: src/scene/bvh_layout.rs).
+    pub bvh_wide_nodes: &'a [BvhWideNode],
     /// One per triangle when `textured`.
     pub triangle_uvs: &'a [TriangleUvs],
     /// The second set, where a texture reads it (else empty).

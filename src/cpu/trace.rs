@@ -18,12 +18,13 @@ use super::texture::{material_at, Textures};
 use super::vertex_color::vertex_colored;
 use super::volume::volume_transmittance;
 use super::Ray;
+use crate::scene::bvh_layout::BvhLayout;
 use crate::scene::KernelScene;
 use crate::shader::has_alpha;
 use crate::shader_types::{
-    BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material, Params, Quad,
-    Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs,
-    NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
+    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
+    Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
+    TriangleUvs, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -42,6 +43,8 @@ pub struct SceneRefs<'a> {
     pub bvh_primitives: &'a [u32],
     /// Empty: no instanced meshes.
     pub instances: &'a [Instance],
+    /// The 4-wide tree where the CPU traverses it (src/scene/bvh_layout.rs), else empty.
+    pub bvh_wide_nodes: &'a [BvhWideNode],
     /// Texture descriptors and texels (`texture.rs`); empty without textures.
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
@@ -79,6 +82,10 @@ impl<'a> SceneRefs<'a> {
             bvh_nodes: &scene.bvh_nodes,
             bvh_primitives: &scene.bvh_primitives,
             instances: &scene.instances,
+            bvh_wide_nodes: match BvhLayout::for_cpu() {
+                BvhLayout::Wide => &scene.bvh_wide_nodes,
+                BvhLayout::Binary => &[],
+            },
             environment_texels: &scene.environment_texels,
             environment_alias: &scene.environment_alias,
             textures: &scene.textures,
@@ -119,6 +126,7 @@ impl<'a> SceneRefs<'a> {
             bvh_nodes: self.bvh_nodes,
             bvh_primitives: self.bvh_primitives,
             instances: self.instances,
+            bvh_wide_nodes: self.bvh_wide_nodes,
             triangle_uvs: self.triangle_uvs,
             triangle_uvs1: self.triangle_uvs1,
             textured: !self.textures.is_empty(),

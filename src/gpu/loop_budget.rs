@@ -39,7 +39,19 @@ pub fn loop_iterations_per_ray(scene: &KernelScene) -> u64 {
     let one_walk = scene.bvh_nodes.len() as u64 + scene.bvh_primitives.len() as u64 + inner_nodes;
     // Each instance's leaf walks its mesh's tree (shaders/traverse/blas.wgsl), which the one
     // walk above bounds, once per instance at most.
-    one_walk * (1 + scene.instances.len() as u64)
+    let binary = one_walk * (1 + scene.instances.len() as u64);
+    // The wide traversal (shaders/traverse/wide.wgsl), where the scene has the wide tree: one
+    // iteration per stack entry (the root and each child, each pushed at most once), four
+    // per inner node to push its children, one per primitive reference tested.
+    let children = scene
+        .bvh_wide_nodes
+        .iter()
+        .flat_map(|n| n.count)
+        .filter(|&c| c != crate::shader_types::WIDE_EMPTY_CHILD)
+        .count() as u64;
+    let wide =
+        1 + children + 4 * scene.bvh_wide_nodes.len() as u64 + scene.bvh_primitives.len() as u64;
+    binary.max(wide)
 }
 
 /// The most loop iterations one sample can take: for the camera ray and each scattering event,

@@ -20,7 +20,7 @@ use crate::shader::{
     render_kernel_source_with_texels, KernelFeatures, KernelVariant, ParamsBinding, SceneBinding,
     RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
-use crate::shader_types::{BvhNode, Params};
+use crate::shader_types::{BvhNode, BvhWideNode, Params};
 use crate::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS};
 use anyhow::{anyhow, Result};
 use bytemuck::Pod;
@@ -221,8 +221,25 @@ impl<'a> GpuRenderer<'a> {
             16
         };
         let uniform_nodes = variant.binding.uniform_node_count();
+        // The wide tree, bound at 44 and 45 in the wide variant only.
+        let (wide_uniform_nodes, _) = variant.binding.wide_sizes();
+        let wide_nodes: &[BvhWideNode] = if matches!(variant.binding, SceneBinding::WideBvh { .. })
+        {
+            &scene.bvh_wide_nodes
+        } else {
+            &[]
+        };
+        // The binary tree, a placeholder where the wide one serves instead.
+        let binary_nodes: &[BvhNode] = if wide_nodes.is_empty() {
+            &scene.bvh_nodes
+        } else {
+            &[]
+        };
         let (usage, scene_type) = match variant.binding {
-            SceneBinding::Storage | SceneBinding::Bvh { .. } | SceneBinding::Hardware => (
+            SceneBinding::Storage
+            | SceneBinding::Bvh { .. }
+            | SceneBinding::WideBvh { .. }
+            | SceneBinding::Hardware => (
                 wgpu::BufferUsages::STORAGE,
                 wgpu::BufferBindingType::Storage { read_only: true },
             ),
@@ -265,7 +282,7 @@ impl<'a> GpuRenderer<'a> {
                     array_bytes(&scene.triangle_normals),
                     read_only,
                 ),
-                BufferNeed::new("BVH nodes", array_bytes(&scene.bvh_nodes), read_only),
+                BufferNeed::new("BVH nodes", array_bytes(binary_nodes), read_only),
                 BufferNeed::new(
                     "BVH top nodes",
                     uniform_nodes as u64 * size_of::<BvhNode>() as u64,
@@ -277,6 +294,7 @@ impl<'a> GpuRenderer<'a> {
                     read_only,
                 ),
                 BufferNeed::new("instances", array_bytes(&scene.instances), read_only),
+                BufferNeed::new("wide BVH nodes", array_bytes(wide_nodes), read_only),
                 BufferNeed::new("textures", array_bytes(&scene.textures), read_only),
                 BufferNeed::new(
                     "triangle texture coordinates",
@@ -332,9 +350,8 @@ impl<'a> GpuRenderer<'a> {
         // Meshes and the BVH are always in storage buffers (placeholders when unused).
         let triangles = storage_buffer(ctx, "triangles", &scene.triangles);
         let triangle_normals = storage_buffer(ctx, "triangle normals", &scene.triangle_normals);
-        let bvh_nodes = storage_buffer(ctx, "BVH nodes", &scene.bvh_nodes);
-        let mut top_nodes =
-            scene.bvh_nodes[..scene.bvh_nodes.len().min(uniform_nodes as usize)].to_vec();
+        let bvh_nodes = storage_buffer(ctx, "BVH nodes", binary_nodes);
+        let mut top_nodes = binary_nodes[..binary_nodes.len().min(uniform_nodes as usize)].to_vec();
         top_nodes.resize(uniform_nodes as usize, BvhNode::default());
         let bvh_top_nodes = scene_buffer(
             ctx,
@@ -443,6 +460,23 @@ impl<'a> GpuRenderer<'a> {
         } else {
             None
         };
+        let wide_buffers = (!wide_nodes.is_empty()).then(|| {
+            let mut top = wide_nodes[..wide_nodes.len().min(wide_uniform_nodes as usize)].to_vec();
+            top.resize(wide_uniform_nodes as usize, BvhWideNode::default());
+            (
+                storage_buffer(ctx, "wide BVH nodes", wide_nodes),
+                scene_buffer(ctx, "wide BVH top nodes", &top, wgpu::BufferUsages::UNIFORM),
+            )
+        });
+        let wide_bindings: Vec<_> = wide_buffers
+            .iter()
+            .flat_map(|(nodes, top)| {
+                [
+                    (44, read_only, nodes),
+                    (45, wgpu::BufferBindingType::Uniform, top),
+                ]
+            })
+            .collect();
         let hardware_buffers: Vec<_> = acceleration
             .iter()
             .map(|a| (27, read_only, &a.references))
@@ -481,6 +515,7 @@ impl<'a> GpuRenderer<'a> {
         ]
         .into_iter()
         .chain(hardware_buffers)
+        .chain(wide_bindings)
         .chain(extra_windows)
         .collect();
         if texel_binding.is_split() {

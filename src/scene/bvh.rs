@@ -31,6 +31,17 @@ pub struct Bvh {
     pub build_seconds: f64,
 }
 
+impl Bvh {
+    /// The tree collapsed 4 wide (`bvh_wide.rs`), or none (empty) where it has more nodes than
+    /// the wide traversal can address; the binary tree then serves every device.
+    pub fn wide_nodes(&self) -> Vec<crate::shader_types::BvhWideNode> {
+        if self.nodes.len() > super::bvh_wide::MAX_WIDE_NODES {
+            return Vec::new();
+        }
+        super::bvh_wide::collapse(&self.nodes)
+    }
+}
+
 fn aabb(min: Vec3, max: Vec3) -> Aabb {
     Aabb::new(min.to_array().into(), max.to_array().into())
 }

@@ -8,11 +8,11 @@ use super::light::LightKind;
 use super::{AlphaMode, Camera, CameraBasis, MaterialKind, Scene, ROULETTE_START_BOUNCE};
 use crate::error::InputError;
 use crate::shader_types::{
-    self, BvhNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture, TriangleColors,
-    TriangleNormals, TriangleTangents, TriangleUvs, ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE,
-    MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR,
-    MATERIAL_UNLIT, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
+    self, BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Params, Texture,
+    TriangleColors, TriangleNormals, TriangleTangents, TriangleUvs, ALPHA_BLEND, ALPHA_MASK,
+    ALPHA_OPAQUE, MATERIAL_DIELECTRIC, MATERIAL_DIFFUSE, MATERIAL_METAL, MATERIAL_PBR,
+    MATERIAL_SPECULAR, MATERIAL_UNLIT, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT,
+    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE, ROULETTE_OFF,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -76,6 +76,9 @@ pub struct KernelScene {
     /// (see [`bvh::wants_bvh`]).
     pub bvh_nodes: Vec<BvhNode>,
     pub bvh_primitives: Vec<u32>,
+    /// The same tree collapsed 4 wide (`bvh_wide.rs`), over the same `bvh_primitives`; empty
+    /// with no BVH. Each device traverses one of the two (`bvh_layout.rs`).
+    pub bvh_wide_nodes: Vec<BvhWideNode>,
     pub bvh_build_seconds: f64,
     /// Texture descriptors and all images' texels (`scene::texture`); empty without textures.
     pub textures: Vec<Texture>,
@@ -115,6 +118,7 @@ impl KernelScene {
             + bytes(&self.triangle_normals)
             + bytes(&self.bvh_nodes)
             + bytes(&self.bvh_primitives)
+            + bytes(&self.bvh_wide_nodes)
             + bytes(&self.textures)
             + bytes(&self.texels)
             + bytes(&self.triangle_uvs)
@@ -409,6 +413,7 @@ impl Scene {
             triangle_normals,
             bvh_nodes: Vec::new(),
             bvh_primitives: Vec::new(),
+            bvh_wide_nodes: Vec::new(),
             bvh_build_seconds: 0.0,
             textures: self.textures.descriptors.clone(),
             texels: self.textures.texels.clone(),
@@ -486,6 +491,12 @@ impl Scene {
                 scene.instances = instances;
                 tree
             };
+            // The wide tree only without instances: its traversal has no instance leaves, and
+            // an instance's mesh is walked in the binary tree (shaders/traverse/blas.wgsl),
+            // which the wide variant does not bind. Scenes with instances keep the binary one.
+            if scene.instances.is_empty() {
+                scene.bvh_wide_nodes = tree.wide_nodes();
+            }
             scene.bvh_nodes = tree.nodes;
             scene.bvh_primitives = tree.primitives;
             scene.bvh_build_seconds = tree.build_seconds;

@@ -8,6 +8,8 @@
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
 pub mod bvh;
+pub mod bvh_layout;
+pub mod bvh_wide;
 mod emitter_power;
 pub mod environment;
 mod file;

@@ -72,6 +72,25 @@ pub fn run_probe_bvh(
     run_probe_source(ctx, entry, params, scene, source)
 }
 
+/// [`run_probe_bvh`] through the 4-wide tree (shaders/traverse/wide.wgsl), its root alone in
+/// the uniform copy of its top.
+pub fn run_probe_bvh_wide(
+    ctx: &GpuContext,
+    entry: &str,
+    params: ProbeParams,
+    scene: &KernelScene,
+) -> Vec<[f32; 4]> {
+    let variant = KernelVariant {
+        binding: SceneBinding::WideBvh {
+            uniform_nodes: 1,
+            stack_size: glint::scene::bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes),
+        },
+        features: KernelFeatures::ALL,
+    };
+    let source = render_kernel_source_for(variant) + PROBE_SOURCE;
+    run_probe_source(ctx, entry, params, scene, source)
+}
+
 /// [`run_probe`] in the kernel variant that traces with ray queries (the hardware traversal),
 /// against `scene`'s acceleration structure; the device must have ray queries.
 pub fn run_probe_hardware(
@@ -125,6 +144,10 @@ fn run_probe_with(
     let bvh_top_nodes = uniform(bytemuck::bytes_of(
         &scene.bvh_nodes.first().copied().unwrap_or_default(),
     ));
+    let bvh_wide_top_nodes = uniform(bytemuck::bytes_of(
+        &scene.bvh_wide_nodes.first().copied().unwrap_or_default(),
+    ));
+    let bvh_wide_nodes = storage_buffer(ctx, "wide BVH nodes", &scene.bvh_wide_nodes);
     let spheres = storage_buffer(ctx, "spheres", &scene.spheres);
     let quads = storage_buffer(ctx, "quads", &scene.quads);
     let materials = storage_buffer(ctx, "materials", &scene.materials);
@@ -189,6 +212,8 @@ fn run_probe_with(
             (23, wgpu::BufferBindingType::Uniform, &bvh_top_nodes),
             (13, read_only, &bvh_primitives),
             (40, read_only, &instances),
+            (44, read_only, &bvh_wide_nodes),
+            (45, wgpu::BufferBindingType::Uniform, &bvh_wide_top_nodes),
             (10, wgpu::BufferBindingType::Uniform, &probe_params),
             (11, read_write, &out),
             (20, read_only, &textures),
