@@ -61,14 +61,10 @@ pub fn run_probe_bvh(
     params: ProbeParams,
     scene: &KernelScene,
 ) -> Vec<[f32; 4]> {
-    let variant = KernelVariant {
-        binding: SceneBinding::Bvh {
-            uniform_nodes: 1,
-            stack_size: glint::scene::bvh::kernel_stack_size(&scene.bvh_nodes),
-        },
-        features: KernelFeatures::ALL,
-    };
-    let source = render_kernel_source_for(variant) + PROBE_SOURCE;
+    let source = probe_source_with(SceneBinding::Bvh {
+        uniform_nodes: 1,
+        stack_size: glint::scene::bvh::kernel_stack_size(&scene.bvh_nodes),
+    });
     run_probe_source(ctx, entry, params, scene, source)
 }
 
@@ -80,14 +76,10 @@ pub fn run_probe_bvh_wide(
     params: ProbeParams,
     scene: &KernelScene,
 ) -> Vec<[f32; 4]> {
-    let variant = KernelVariant {
-        binding: SceneBinding::WideBvh {
-            uniform_nodes: 1,
-            stack_size: glint::scene::bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes),
-        },
-        features: KernelFeatures::ALL,
-    };
-    let source = render_kernel_source_for(variant) + PROBE_SOURCE;
+    let source = probe_source_with(SceneBinding::WideBvh {
+        uniform_nodes: 1,
+        stack_size: glint::scene::bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes),
+    });
     run_probe_source(ctx, entry, params, scene, source)
 }
 
@@ -99,13 +91,18 @@ pub fn run_probe_hardware(
     params: ProbeParams,
     scene: &KernelScene,
 ) -> Vec<[f32; 4]> {
-    let variant = KernelVariant {
-        binding: SceneBinding::Hardware,
-        features: KernelFeatures::ALL,
-    };
-    let source = render_kernel_source_for(variant) + PROBE_SOURCE;
+    let source = probe_source_with(SceneBinding::Hardware);
     let acceleration = glint::gpu::acceleration::build(ctx, scene).unwrap();
     run_probe_with(ctx, entry, params, scene, source, Some(&acceleration))
+}
+
+/// The kernel with every feature, reading the scene through `binding`, and the probe's entry
+/// points after it.
+fn probe_source_with(binding: SceneBinding) -> String {
+    render_kernel_source_for(KernelVariant {
+        binding,
+        features: KernelFeatures::ALL,
+    }) + PROBE_SOURCE
 }
 
 fn run_probe_source(
