@@ -244,7 +244,7 @@ pub fn light_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) -> bo
     if light.primitive == PRIMITIVE_LIGHT {
         return punctual_visible(scene, shadow, light);
     }
-    first_hit_is(&scene.geometry(), shadow, light.primitive, light.index)
+    first_hit_is(&scene.geometry, shadow, light.primitive, light.index)
 }
 
 /// The MIS weight of a light sample against BSDF sampling, which would have drawn its

@@ -88,18 +88,18 @@ pub fn sample_punctual(
 /// `light.index`: the light's position for a point or spot, the sky for a sun.
 pub fn punctual_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) -> bool {
     let l = &scene.lights[light.index as usize];
-    let geometry = scene.geometry();
+    let geometry = &scene.geometry;
     if l.kind == LIGHT_SUN {
-        return escapes(&geometry, shadow);
+        return escapes(geometry, shadow);
     }
     let t_light = (Vec3::from(l.position) - shadow.origin).dot(shadow.dir);
     if !geometry.bvh_nodes.is_empty() {
         // Any hit nearer than the light ends the search (a target no primitive matches).
         let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
-        return bvh_traverse(&geometry, &bvh_ray(shadow), t_light, t_light, 0, no_target).t
+        return bvh_traverse(geometry, &bvh_ray(shadow), t_light, t_light, 0, no_target).t
             == super::intersect::NO_HIT;
     }
-    closest_primitive(&geometry, shadow).t >= t_light
+    closest_primitive(geometry, shadow).t >= t_light
 }
 
 /// Radiance of the sun disks a ray escaping along `dir` looks into. With `mis`, each is

@@ -63,15 +63,16 @@ pub struct SceneRefs<'a> {
     pub lights: &'a [Light],
     /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
     pub has_alpha: bool,
-    /// The key of the ray segment being traced (the kernel's private `alpha_key`), which
-    /// `path_step` sets when `has_alpha`.
-    pub alpha_key: u32,
+    /// What intersection reads: the arrays above, and the key of the ray segment being traced
+    /// (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`. Built once
+    /// here, not per ray: building it for every ray and shadow ray was 3% of a CPU render.
+    pub geometry: Geometry<'a>,
 }
 
 impl<'a> SceneRefs<'a> {
     /// `scene`'s arrays with `params` in place of its own.
     pub fn of(scene: &'a KernelScene, params: &'a Params) -> SceneRefs<'a> {
-        SceneRefs {
+        let mut refs = SceneRefs {
             params,
             spheres: &scene.spheres,
             quads: &scene.quads,
@@ -96,8 +97,10 @@ impl<'a> SceneRefs<'a> {
             triangle_colors: &scene.triangle_colors,
             lights: &scene.lights,
             has_alpha: has_alpha(&scene.materials),
-            alpha_key: 0,
-        }
+            geometry: Geometry::default(),
+        };
+        refs.geometry = refs.build_geometry();
+        refs
     }
 
     /// What texture lookups read.
@@ -110,14 +113,17 @@ impl<'a> SceneRefs<'a> {
 
     /// The same scene tracing the ray segment whose alpha key is `key`.
     pub fn with_alpha_key(&self, key: u32) -> SceneRefs<'a> {
-        SceneRefs {
-            alpha_key: key,
-            ..*self
-        }
+        let mut keyed = *self;
+        keyed.geometry.alpha.key = key;
+        keyed
     }
 
     /// What intersection reads.
     pub fn geometry(&self) -> Geometry<'a> {
+        self.geometry
+    }
+
+    fn build_geometry(&self) -> Geometry<'a> {
         Geometry {
             spheres: self.spheres,
             quads: self.quads,
@@ -137,7 +143,7 @@ impl<'a> SceneRefs<'a> {
                 triangle_uvs: self.triangle_uvs,
                 triangle_uvs1: self.triangle_uvs1,
                 triangle_colors: self.triangle_colors,
-                key: self.alpha_key,
+                key: 0,
             },
         }
     }
@@ -208,7 +214,7 @@ pub fn path_step(
     } else {
         scene
     };
-    let mut hit = intersect_scene(&scene.geometry(), &ray);
+    let mut hit = intersect_scene(&scene.geometry, &ray);
     *segments += 1;
     if hit.t == NO_HIT {
         // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
@@ -242,15 +248,20 @@ pub fn path_step(
         path.radiance += firefly_clamp(params, path.throughput * escaped, bounce);
         return true;
     }
-    let m = &vertex_colored(
-        scene.triangle_colors,
-        &material_at(
-            &scene.textures(),
-            &scene.materials[hit.material as usize],
-            hit.uv,
-        ),
-        &hit,
-    );
+    // The material as stored, unless textures or vertex colours change it at this hit (the
+    // kernel's HAS_TEXTURES and HAS_VERTEX_COLORS): a 160-byte copy per hit otherwise.
+    let stored = &scene.materials[hit.material as usize];
+    let varied;
+    let m = if scene.textures.is_empty() && scene.triangle_colors.is_empty() {
+        stored
+    } else {
+        varied = vertex_colored(
+            scene.triangle_colors,
+            &material_at(&scene.textures(), stored, hit.uv),
+            &hit,
+        );
+        &varied
+    };
     // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
     // else the unmapped one; the base's normal map does not reach it.
     let mut coat_normal = hit.shading_normal;
