@@ -1090,3 +1090,22 @@ fn gltf_instance_counts_beyond_the_copy_limit_load_stored_once() {
         assert!(message.contains(needle), "{message:?} lacks {needle:?}");
     }
 }
+
+/// A use that cannot be inverted (a node scaled by 0, as files do to hide one) leaves the
+/// reused mesh copied, as before: the other two uses' triangles in the scene's, the hidden
+/// one's, all of zero area, skipped; stored once, rays could not be taken into its coordinates.
+#[test]
+fn gltf_reuse_with_a_zero_scale_node_is_copied() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = reuse_mesh();
+    let mut placements = REUSE_TRS;
+    placements[1].2 = [0.0; 3];
+    let scene = load_reuse(
+        dir.path(),
+        &reuse_gltf(&mesh, GREY, &placements, Reuse::Nodes),
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.instanced.is_empty());
+    assert_eq!(scene.triangles.len(), 2 * mesh.indices.len());
+}
