@@ -582,14 +582,18 @@ fn load_gltf(dir: &Path, gltf: &str) -> Result<Scene, SceneError> {
 #[test]
 fn gltf_gpu_instancing_is_child_nodes() {
     let dir = tempfile::tempdir().unwrap();
-    let instanced =
-        load_gltf(dir.path(), &instancing_gltf(INSTANCED_NODE)).unwrap_or_else(|e| panic!("{e}"));
+    // Both are stored once (one triangle, three placements); placed, they are compared.
+    let instanced = load_gltf(dir.path(), &instancing_gltf(INSTANCED_NODE))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .flattened();
     // Listed last first: the hierarchy's walk takes the last child first.
     let children = r#"{"translation": [0.0, 0.0, 5.0], "children": [3, 2, 1]},
 {"mesh": 0, "translation": [-1.0, 0.0, 0.0]},
 {"mesh": 0, "translation": [1.0, 0.5, 0.0], "rotation": [0.0, 0.38268343, 0.0, 0.9238795], "scale": [2.0, 2.0, 2.0]},
 {"mesh": 0, "translation": [0.0, -1.0, 0.25], "rotation": [0.5, 0.5, 0.5, 0.5], "scale": [1.0, 0.5, 3.0]}"#;
-    let nodes = load_gltf(dir.path(), &instancing_gltf(children)).unwrap_or_else(|e| panic!("{e}"));
+    let nodes = load_gltf(dir.path(), &instancing_gltf(children))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .flattened();
     assert_eq!(instanced.triangles.len(), 3);
     assert_eq!(instanced.triangles, nodes.triangles);
     // The second instance: scaled by 2, turned 45° about y, moved by (1, 0.5, 0) and (0, 0, 5).
@@ -700,4 +704,408 @@ fn hardware_traversal_refuses_instances() {
             .expect("a hardware renderer of instances");
         assert!(e.to_string().contains("instanced meshes"), "{e}");
     }
+}
+
+// -------------------------------------------------------------------------------------------
+// glTF meshes placed many times by the file itself: nodes that reuse a mesh, and
+// EXT_mesh_gpu_instancing, are stored once under `instances`' rule (src/scene/mesh/reuse.rs):
+// a primitive placed two or more times whose material neither emits, nor is alpha-tested or
+// blended, nor maps normals. Its triangles keep their vertex normals, colours and both
+// texture coordinates, as a TOML instance's do.
+
+/// A node's or a GPU instance's translation, rotation (a unit quaternion, x y z w) and scale.
+type Trs = ([f32; 3], [f32; 4], [f32; 3]);
+
+/// Three placements: translated, turned 90° about y and scaled by 1.5, and turned 45° about
+/// z and scaled per axis.
+const REUSE_TRS: [Trs; 3] = [
+    ([-2.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0], [1.0, 1.0, 1.0]),
+    (
+        [2.0, 0.5, 1.0],
+        [
+            0.0,
+            std::f32::consts::FRAC_1_SQRT_2,
+            0.0,
+            std::f32::consts::FRAC_1_SQRT_2,
+        ],
+        [1.5, 1.5, 1.5],
+    ),
+    (
+        [0.0, -1.5, 0.0],
+        [0.0, 0.0, 0.382_683_43, 0.923_879_5],
+        [1.0, 0.5, 2.0],
+    ),
+];
+
+/// A glTF opaque grey, and one that also emits.
+const GREY: &str =
+    r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0}}"#;
+const GLOWING: &str = r#"{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0}, "emissiveFactor": [1.0, 0.5, 0.25]}"#;
+
+/// How a glTF file places its mesh.
+#[derive(Clone, Copy, PartialEq)]
+enum Reuse {
+    /// One node per placement, all using mesh 0.
+    Nodes,
+    /// One node per placement, each with its own copy of the mesh (the same accessors):
+    /// nothing reused, so everything is flattened, as every glTF file was before.
+    DistinctMeshes,
+    /// One node with EXT_mesh_gpu_instancing.
+    GpuInstancing,
+}
+
+/// A glTF file of `mesh` (positions, normals, vertex colours, TEXCOORD_0 and _1, u32 indices)
+/// in `material` (a glTF material), placed at each of `placements` as `reuse` says.
+fn reuse_gltf(mesh: &StressMesh, material: &str, placements: &[Trs], reuse: Reuse) -> String {
+    use base64::Engine as _;
+    let n = mesh.positions.len();
+    let colors: Vec<f32> = mesh
+        .normals
+        .iter()
+        .flat_map(|v| [0.3 + 0.7 * v.x.abs(), 0.3 + 0.7 * v.y.abs(), 0.3, 1.0])
+        .collect();
+    let uvs: Vec<f32> = mesh
+        .positions
+        .iter()
+        .flat_map(|p| [0.5 + 0.5 * p.x, 0.5 + 0.5 * p.y])
+        .collect();
+    let mut arrays: Vec<(Vec<u8>, usize, &str, u32)> = vec![
+        (
+            f32_bytes(mesh.positions.iter().flat_map(|p| p.to_array())),
+            n,
+            "VEC3",
+            5126,
+        ),
+        (
+            f32_bytes(mesh.normals.iter().flat_map(|p| p.to_array())),
+            n,
+            "VEC3",
+            5126,
+        ),
+        (f32_bytes(colors), n, "VEC4", 5126),
+        (f32_bytes(uvs), n, "VEC2", 5126),
+        (
+            mesh.indices
+                .iter()
+                .flatten()
+                .flat_map(|i| i.to_le_bytes())
+                .collect(),
+            3 * mesh.indices.len(),
+            "SCALAR",
+            5125,
+        ),
+    ];
+    if reuse == Reuse::GpuInstancing {
+        let m = placements.len();
+        arrays.push((
+            f32_bytes(placements.iter().flat_map(|p| p.0)),
+            m,
+            "VEC3",
+            5126,
+        ));
+        arrays.push((
+            f32_bytes(placements.iter().flat_map(|p| p.1)),
+            m,
+            "VEC4",
+            5126,
+        ));
+        arrays.push((
+            f32_bytes(placements.iter().flat_map(|p| p.2)),
+            m,
+            "VEC3",
+            5126,
+        ));
+    }
+    let (mut bytes, mut views, mut accessors) = (Vec::new(), Vec::new(), Vec::new());
+    for (k, (data, count, kind, component)) in arrays.iter().enumerate() {
+        views.push(format!(
+            r#"{{"buffer": 0, "byteOffset": {}, "byteLength": {}}}"#,
+            bytes.len(),
+            data.len()
+        ));
+        accessors.push(format!(
+            r#"{{"bufferView": {k}, "componentType": {component}, "count": {count}, "type": "{kind}"}}"#
+        ));
+        bytes.extend(data);
+    }
+    let trs = |p: &Trs| {
+        format!(
+            r#""translation": {:?}, "rotation": {:?}, "scale": {:?}"#,
+            p.0, p.1, p.2
+        )
+    };
+    let copies = if reuse == Reuse::DistinctMeshes {
+        placements.len()
+    } else {
+        1
+    };
+    // The hierarchy's walk takes the last child first: listed last first, the nodes are
+    // placed in the placements' order.
+    let nodes = match reuse {
+        Reuse::GpuInstancing => vec![
+            r#"{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {"attributes": {"TRANSLATION": 5, "ROTATION": 6, "SCALE": 7}}}}"#
+                .to_string(),
+        ],
+        _ => std::iter::once(format!(
+            r#"{{"children": {:?}}}"#,
+            (1..=placements.len()).rev().collect::<Vec<_>>()
+        ))
+        .chain(placements.iter().enumerate().map(|(k, p)| {
+            let mesh = if reuse == Reuse::Nodes { 0 } else { k };
+            format!(r#"{{"mesh": {mesh}, {}}}"#, trs(p))
+        }))
+        .collect(),
+    };
+    let primitive = r#"{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "COLOR_0": 2, "TEXCOORD_0": 3, "TEXCOORD_1": 3}, "indices": 4, "material": 0}]}"#;
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["EXT_mesh_gpu_instancing"],
+"buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{}"}}],
+"bufferViews": [{}], "accessors": [{}], "materials": [{material}],
+"meshes": [{}], "nodes": [{}], "scenes": [{{"nodes": [0]}}], "scene": 0}}"#,
+        bytes.len(),
+        base64::engine::general_purpose::STANDARD.encode(&bytes),
+        views.join(", "),
+        accessors.join(", "),
+        vec![primitive; copies].join(", "),
+        nodes.join(", ")
+    )
+}
+
+fn f32_bytes(values: impl IntoIterator<Item = f32>) -> Vec<u8> {
+    values.into_iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// `model.gltf` holding `gltf`, placed by a scene in `dir` with its own materials, and
+/// `instances` (a TOML list) if given.
+fn load_reuse(dir: &Path, gltf: &str, instances: Option<&str>) -> Result<Scene, SceneError> {
+    std::fs::write(dir.join("model.gltf"), gltf).unwrap();
+    let instances = instances.map_or(String::new(), |list| format!("instances = {list}\n"));
+    load(
+        dir,
+        &format!("{MESH_SCENE_HEADER}\n[[meshes]]\nfile = \"model.gltf\"\n{instances}"),
+    )
+}
+
+/// The small mesh the reuse tests place.
+fn reuse_mesh() -> StressMesh {
+    StressMesh::new(24, 12)
+}
+
+/// A mesh reused by three nodes, and one placed three times by EXT_mesh_gpu_instancing, are
+/// stored once: its triangles once, three placements, the kernel's triangles those once and
+/// three instances; with their vertex normals, colours and both texture coordinates. Placed,
+/// they are the triangles of the same file with a mesh per node (flattened as before), their
+/// vertices bit for bit (the same matrices, the mesh's own coordinates the file's), their
+/// normals to rounding. With an entry's two `instances`, the file's three uses make six
+/// placements, instance after instance, each with the uses in order.
+#[test]
+fn gltf_reused_meshes_are_stored_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = reuse_mesh();
+    let per_mesh = mesh.indices.len();
+    let flat = load_reuse(
+        dir.path(),
+        &reuse_gltf(&mesh, GREY, &REUSE_TRS, Reuse::DistinctMeshes),
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(flat.instanced.is_empty());
+    assert_eq!(flat.triangles.len(), 3 * per_mesh);
+    for reuse in [Reuse::Nodes, Reuse::GpuInstancing] {
+        let scene = load_reuse(
+            dir.path(),
+            &reuse_gltf(&mesh, GREY, &REUSE_TRS, reuse),
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert!(scene.triangles.is_empty());
+        assert_eq!(scene.instanced.len(), 1);
+        assert_eq!(scene.instanced[0].triangles.len(), per_mesh);
+        assert_eq!(scene.instanced[0].placements.len(), 3);
+        for t in &scene.instanced[0].triangles {
+            assert!(t.normals.is_some() && t.colors.is_some());
+            assert!(t.uvs.is_some() && t.uvs1.is_some());
+        }
+        let placed = scene.flattened();
+        assert_eq!(placed.triangles.len(), flat.triangles.len());
+        for (a, b) in placed.triangles.iter().zip(&flat.triangles) {
+            assert_eq!(a.vertices, b.vertices);
+            assert_eq!((a.colors, a.uvs, a.uvs1), (b.colors, b.uvs, b.uvs1));
+            for (x, y) in a.normals.unwrap().iter().zip(b.normals.unwrap()) {
+                assert!((*x - y).abs().max_element() < 1e-6, "{x} {y}");
+            }
+        }
+        let kernel = lit(scene);
+        assert_eq!(kernel.triangles.len(), per_mesh);
+        assert_eq!(kernel.instances.len(), 3);
+        assert_eq!(kernel.params.triangle_count, 0);
+    }
+    let both = load_reuse(
+        dir.path(),
+        &reuse_gltf(&mesh, GREY, &REUSE_TRS, Reuse::Nodes),
+        Some("[{}, { translate = [0.0, 0.0, 3.0] }]"),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(both.instanced.len(), 1);
+    let placements = &both.instanced[0].placements;
+    assert_eq!(placements.len(), 6);
+    for (k, placement) in placements.iter().enumerate() {
+        let (t, r, s) = REUSE_TRS[k % 3];
+        let node = Mat4::from_scale_rotation_translation(
+            Vec3::from(s),
+            glam::Quat::from_array(r),
+            Vec3::from(t),
+        );
+        let expected = Mat4::from_translation(Vec3::new(0.0, 0.0, 3.0 * (k / 3) as f32)) * node;
+        assert!(placement.abs_diff_eq(expected, 1e-6), "{k}: {placement}");
+    }
+}
+
+/// The reused mesh, stored once, renders the image of the same file flattened: on the CPU at
+/// 1 spp, 99% of paths agree to 1e-3 (the bound of `instances_are_the_flattened_meshes_on_the_cpu`,
+/// from tests/gpu_vs_cpu.rs: a ray tested in an instance's coordinates rounds differently),
+/// for nodes and for EXT_mesh_gpu_instancing.
+#[test]
+fn gltf_reused_meshes_are_the_flattened_meshes_on_the_cpu() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = reuse_mesh();
+    let scene = |reuse| {
+        lit(load_reuse(
+            dir.path(),
+            &reuse_gltf(&mesh, GREY, &REUSE_TRS, reuse),
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}")))
+    };
+    let flat = render_cpu(&scene(Reuse::DistinctMeshes), 1);
+    for reuse in [Reuse::Nodes, Reuse::GpuInstancing] {
+        let instanced = scene(reuse);
+        assert_eq!(instanced.instances.len(), 3);
+        let mut agreement = PathAgreement::default();
+        agreement.add(&flat, &render_cpu(&instanced, 1));
+        agreement.check(0.99);
+    }
+}
+
+/// The same on the GPU: the stored-once scene traces the flattened one's paths, and the CPU's
+/// (1 spp, tests/gpu_vs_cpu.rs's 99% bound).
+#[test]
+fn gltf_reused_meshes_are_the_flattened_meshes_on_the_gpu() {
+    let Some(ctx) = gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = reuse_mesh();
+    let scene = |reuse| {
+        lit(load_reuse(
+            dir.path(),
+            &reuse_gltf(&mesh, GREY, &REUSE_TRS, reuse),
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}")))
+    };
+    let flat = render_gpu(ctx, &scene(Reuse::DistinctMeshes), 1);
+    for reuse in [Reuse::Nodes, Reuse::GpuInstancing] {
+        let instanced = scene(reuse);
+        assert_eq!(instanced.instances.len(), 3);
+        let image = render_gpu(ctx, &instanced, 1);
+        let mut agreement = PathAgreement::default();
+        agreement.add(&flat, &image);
+        agreement.check(0.99);
+        let mut agreement = PathAgreement::default();
+        agreement.add(&render_cpu(&instanced, 1), &image);
+        agreement.check(0.99);
+    }
+}
+
+/// An emitting mesh reused by nodes is copied, as before: the file with a mesh per node has
+/// the same triangles and the same emitter table, to the bit, and the same CPU image; and the
+/// copies light the scene (under a black sky, the pixels that see them, about a fifth of the
+/// frame, carry light).
+#[test]
+fn gltf_reused_emitting_meshes_stay_flattened() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = reuse_mesh();
+    let scene = |reuse| {
+        load_reuse(
+            dir.path(),
+            &reuse_gltf(&mesh, GLOWING, &REUSE_TRS, reuse),
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let (reused, flat) = (scene(Reuse::Nodes), scene(Reuse::DistinctMeshes));
+    assert!(reused.instanced.is_empty());
+    assert_eq!(reused.triangles, flat.triangles);
+    assert_eq!(reused.render.background, Vec3::ZERO);
+    let (reused, flat) = (common::sized(reused, 24, 3), common::sized(flat, 24, 3));
+    assert_eq!(reused.emitters.len(), 3 * mesh.indices.len());
+    assert_eq!(
+        format!("{:?}", reused.emitters),
+        format!("{:?}", flat.emitters)
+    );
+    let image = render_cpu(&reused, 2);
+    assert_eq!(image.pixels, render_cpu(&flat, 2).pixels);
+    let lit_pixels = image.pixels.iter().filter(|p| p[0] > 0.0).count();
+    assert!(lit_pixels > image.pixels.len() / 6, "{lit_pixels}");
+}
+
+/// A placement count that used to be refused now loads when stored once: a 2·10⁵-triangle
+/// mesh placed 200 times by EXT_mesh_gpu_instancing (4·10⁷ triangles, more than the 2²⁵ one
+/// entry may copy) holds its triangles once. Emitting, it would be copied, and is refused
+/// with the copy limit named, before any copy is made.
+#[test]
+fn gltf_instance_counts_beyond_the_copy_limit_load_stored_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let big = StressMesh::new(400, 251);
+    assert_eq!(big.indices.len(), 200_000);
+    let grid: Vec<Trs> = (0..200)
+        .map(|i| {
+            (
+                [(i % 20) as f32 * 3.0, (i / 20) as f32 * 3.0, 10.0],
+                [0.0, 0.0, 0.0, 1.0],
+                [1.0; 3],
+            )
+        })
+        .collect();
+    let scene = load_reuse(
+        dir.path(),
+        &reuse_gltf(&big, GREY, &grid, Reuse::GpuInstancing),
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.triangles.is_empty());
+    assert_eq!(scene.instanced[0].triangles.len(), 200_000);
+    assert_eq!(scene.placed_triangle_count(), 40_000_000);
+    let e = load_reuse(
+        dir.path(),
+        &reuse_gltf(&big, GLOWING, &grid, Reuse::GpuInstancing),
+        None,
+    )
+    .expect_err("too many copies");
+    let message = e.to_string();
+    for needle in [
+        "meshes[0].file",
+        "40000000 triangles",
+        "more than the 33554432",
+    ] {
+        assert!(message.contains(needle), "{message:?} lacks {needle:?}");
+    }
+}
+
+/// A use that cannot be inverted (a node scaled by 0, as files do to hide one) leaves the
+/// reused mesh copied, as before: the other two uses' triangles in the scene's, the hidden
+/// one's, all of zero area, skipped; stored once, rays could not be taken into its coordinates.
+#[test]
+fn gltf_reuse_with_a_zero_scale_node_is_copied() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = reuse_mesh();
+    let mut placements = REUSE_TRS;
+    placements[1].2 = [0.0; 3];
+    let scene = load_reuse(
+        dir.path(),
+        &reuse_gltf(&mesh, GREY, &placements, Reuse::Nodes),
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(scene.instanced.is_empty());
+    assert_eq!(scene.triangles.len(), 2 * mesh.indices.len());
 }

@@ -331,7 +331,10 @@ fn a_good_gltf_loads_with_its_hierarchy_instances_and_sparse_values() {
             "values": {"bufferView": 1}
         });
     });
+    // Reused, the mesh is stored once (tests/instancing.rs): its placed triangles are checked.
     let scene = scene.unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.instanced.len(), 1);
+    let scene = scene.flattened();
     assert_eq!(scene.triangles.len(), 2);
     let mut corners: Vec<[f32; 3]> = scene
         .triangles

@@ -83,8 +83,9 @@ pub struct Scene {
     pub quads: Vec<Quad>,
     /// Every mesh's triangles, in the scene's coordinates, but those of instanced meshes.
     pub triangles: Vec<Triangle>,
-    /// Meshes placed many times without copies (`[[meshes]] instances`, see
-    /// [`InstancedMesh`]); their triangles are not in `triangles`.
+    /// Meshes placed many times without copies (`[[meshes]] instances`, glTF meshes reused by
+    /// nodes or `EXT_mesh_gpu_instancing`; see [`InstancedMesh`]); their triangles are not in
+    /// `triangles`.
     pub instanced: Vec<InstancedMesh>,
     /// The textures materials refer to.
     pub textures: texture::TextureSet,
@@ -96,9 +97,10 @@ pub struct Scene {
 
 /// A mesh placed many times and stored once: the two-level structure's bottom level
 /// (src/scene/kernel.rs lays it out, shaders/traverse/blas.wgsl traces it). Its triangles are
-/// in the mesh's own coordinates (its `[[meshes]]` transform applied), and each placement
-/// takes them to the scene's. Only opaque meshes that do not emit and have no normal map are
-/// held so (`validate/objects.rs` says why); others are flattened into [`Scene::triangles`].
+/// in the mesh file's own coordinates (a glTF primitive's, before its node's transform), and
+/// each placement takes them to the scene's. Only opaque meshes that do not emit and have no
+/// normal map are held so ([`Material::two_level`] says why, `mesh/reuse.rs` which parts);
+/// others are flattened into [`Scene::triangles`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct InstancedMesh {
     pub triangles: Vec<Triangle>,
@@ -284,6 +286,20 @@ impl Material {
         self.normal_texture.is_some()
             || matches!(&self.kind, MaterialKind::Pbr { layers, .. }
                 if layers.clearcoat_normal_texture.is_some())
+    }
+
+    /// Whether a mesh in this material may be stored once and placed by transforms (the
+    /// two-level structure, [`InstancedMesh`]), rather than copied per placement. Not when it
+    /// emits: light sampling picks emitting triangles by their power in the scene's
+    /// coordinates, one table entry per placed triangle (src/scene/kernel.rs), which an
+    /// instance would have to sample through its transform. Not when alpha-tested or blended,
+    /// nor with a normal map: the alpha test and the tangent frame would need the instance
+    /// too. Those are copied as before, which is exact.
+    pub fn two_level(&self) -> bool {
+        self.emitted_radiance == Vec3::ZERO
+            && self.emission_texture.is_none()
+            && self.alpha.mode == AlphaMode::Opaque
+            && !self.has_normal_map()
     }
 }
 

@@ -147,8 +147,17 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
     .map_err(|message| error(strip_prefix(&message, &file_name)))?;
     warnings.extend(loaded.warnings);
     warnings.append(&mut textures.warnings);
-    let triangles = loaded.triangles;
-    let (centre, radius) = bounding_sphere(triangles.iter().flat_map(|t| t.vertices));
+    let (triangles, instanced) = (loaded.triangles, loaded.instanced);
+    // Framed on every placed vertex, instanced meshes' too (placed here, not stored).
+    let (centre, radius) = bounding_sphere(triangles.iter().flat_map(|t| t.vertices).chain(
+        instanced.iter().flat_map(|m| {
+            m.placements.iter().flat_map(move |p| {
+                m.triangles
+                    .iter()
+                    .flat_map(move |t| t.vertices.map(|v| p.transform_point3(v)))
+            })
+        }),
+    ));
 
     let is_gltf = mesh::is_gltf(path);
     let file_camera = if is_gltf {
@@ -215,7 +224,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
         spheres: Vec::new(),
         quads: Vec::new(),
         triangles,
-        instanced: Vec::new(),
+        instanced,
         textures,
         environment: Some(environment),
         lights,

@@ -17,7 +17,7 @@ use super::gltf_material::material;
 use super::gltf_nodes::placed_nodes;
 use super::{
     one_line, read_mesh_bytes, FileTextures, Geometry, ImageSource, MeshFile, MeshPart,
-    MAX_PLACED_TRIANGLES, MAX_TRIANGLES,
+    MAX_TRIANGLES,
 };
 use crate::input_file::{format_size, read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::texture::Sampling;
@@ -138,40 +138,36 @@ pub(super) fn read_gltf(path: &Path) -> Result<MeshFile, String> {
         has_other_textures |= other_textures;
     }
 
-    // Every primitive the scene places is checked before any is read, and the triangles
-    // counted: a small file must not make the instances' triangles exceed glint's limit. A
-    // primitive counts as one triangle at least, which bounds the parts made too.
-    // EXT_mesh_gpu_instancing's copies are bounded as a scene's `instances` are
-    // (MAX_PLACED_TRIANGLES): a few bytes of accessor place a whole mesh again.
+    // Every primitive the scene places is checked before any is read, and counted: each mesh's
+    // triangles once (what is stored once, src/scene/mesh/reuse.rs, costs no more), and the
+    // parts made, one per primitive placed, within glint's triangle limit. What is copied per
+    // placement is bounded where the materials are known (`load_placed`, MAX_PLACED_TRIANGLES),
+    // before any copy is made.
     let mut plans: HashMap<usize, Vec<PrimitivePlan>> = HashMap::new();
-    let mut triangles = 0u64;
-    let mut gpu_instanced = 0u64;
+    let (mut unique, mut placed_parts) = (0u64, 0u64);
     for instance in &instances {
         let plan = match plans.entry(instance.mesh) {
             Entry::Occupied(plan) => plan.into_mut(),
-            Entry::Vacant(slot) => slot.insert(mesh_plan(&root, &buffers, instance.mesh)?),
+            Entry::Vacant(slot) => {
+                let plan = slot.insert(mesh_plan(&root, &buffers, instance.mesh)?);
+                unique += plan.iter().map(|p| p.triangles.max(1)).sum::<u64>();
+                plan
+            }
         };
         let copies = instance
             .gpu_instances
             .as_ref()
             .map_or(1, |a| a.count as u64);
-        let placed = plan.iter().map(|p| p.triangles.max(1)).sum::<u64>() * copies;
-        triangles += placed;
-        if instance.gpu_instances.is_some() {
-            gpu_instanced += placed;
-            if gpu_instanced > MAX_PLACED_TRIANGLES as u64 {
-                return Err(format!(
-                    "nodes[{}].extensions.{}: the file's instances place more than \
-                     {MAX_PLACED_TRIANGLES} triangles, the most glint copies for instances",
-                    instance.node,
-                    gltf_instancing::EXTENSION
-                ));
-            }
-        }
-        if triangles > MAX_TRIANGLES as u64 {
+        placed_parts += plan.len() as u64 * copies;
+        if unique.max(placed_parts) > MAX_TRIANGLES as u64 {
             return Err(format!(
-                "nodes[{}]: the scene's nodes place more than {MAX_TRIANGLES} triangles, glint's limit",
-                instance.node
+                "nodes[{}]: the scene's nodes place more than {MAX_TRIANGLES} {}, glint's limit",
+                instance.node,
+                if unique > placed_parts {
+                    "triangles"
+                } else {
+                    "primitives"
+                }
             ));
         }
     }

@@ -5,8 +5,9 @@
 //!
 //! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`; a glTF file's node hierarchy, cameras
 //! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`;
-//! `EXT_mesh_gpu_instancing` in `gltf_instancing.rs`); this file holds what they share: the
-//! parts a file yields, the material checks, and turning parts into scene triangles.
+//! `EXT_mesh_gpu_instancing` in `gltf_instancing.rs`); which parts are stored once rather
+//! than copied in `reuse.rs`; this file holds what they share: the parts a file yields, the
+//! material checks, and turning parts into scene triangles and instanced meshes.
 
 mod gltf;
 mod gltf_cameras;
@@ -16,6 +17,7 @@ mod gltf_material;
 mod gltf_nodes;
 mod obj;
 mod ply;
+mod reuse;
 mod tangents;
 
 pub use gltf_cameras::{gltf_camera, no_such_camera, FileCamera};
@@ -23,7 +25,7 @@ pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
 use super::texture::{Sampling, TextureSet, TextureUse};
-use super::{Material, MaterialKind, Triangle};
+use super::{InstancedMesh, Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use std::path::{Path, PathBuf};
@@ -33,11 +35,16 @@ use std::rc::Rc;
 /// fit any GPU's storage binding anyway.
 pub const MAX_TRIANGLES: usize = 1 << 28;
 
-/// The most triangles one `[[meshes]]` entry's instances may place in all: about what one
+/// The most triangles one `[[meshes]]` entry may copy in all, counting every placement (its
+/// `instances`, and a glTF file's reused meshes) of what is not stored once: about what one
 /// mesh file within the 1 GiB file limit can hold (a binary PLY of a closed mesh, ~25 bytes a
-/// triangle). Instances are copies, so without this a small file placed many times could ask
-/// for far more memory than any mesh file could.
+/// triangle). Without this a small file placed many times could ask for far more memory than
+/// any mesh file could.
 pub const MAX_PLACED_TRIANGLES: usize = 1 << 25;
+
+/// The most instances a scene's instanced meshes may have in all: their transforms
+/// (`shader_types::Instance`, 112 bytes each) fill one 128 MiB binding at about 1.2·10⁶.
+pub const MAX_INSTANCES: usize = 1 << 20;
 
 /// Triangle `t` moved by `matrix`: its vertices, its normals through the inverse transpose of
 /// the linear part (renormalised), its tangents through the linear part, as [`load_placed`]
@@ -183,7 +190,10 @@ pub(super) struct FileTextures {
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
 pub(crate) struct LoadedMesh {
+    /// Triangles copied into the scene's coordinates.
     pub triangles: Vec<Triangle>,
+    /// What is placed two or more times and stored once ([`reuse`]).
+    pub instanced: Vec<InstancedMesh>,
     /// One line each, for stderr.
     pub warnings: Vec<String>,
 }
@@ -211,9 +221,10 @@ pub(crate) fn load(
 }
 
 /// [`load`] with the file placed once per matrix in `placements` (a `[[meshes]]` entry's
-/// `instances`): the file is read and checked once, and each placement adds its own copy of
-/// the triangles, placement after placement. Instances are flattened into world-space
-/// triangles like any mesh, so memory grows with the instances, not only the unique geometry.
+/// `instances`): the file is read and checked once. What is placed two or more times, by the
+/// entry or by the file itself (glTF nodes that reuse a mesh, `EXT_mesh_gpu_instancing`), is
+/// stored once where its materials allow ([`reuse`] says which); everything else is copied
+/// into world-space triangles, placement after placement.
 pub(crate) fn load_placed(
     path: &Path,
     shown: &str,
@@ -263,41 +274,31 @@ pub(crate) fn load_placed(
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    // Checked before any copy is made: many placements of a large file would otherwise fill
-    // the memory before the count is seen.
-    let faces: usize = file.parts.iter().map(|p| p.geometry.indices.len()).sum();
-    let placed = faces.saturating_mul(placements.len());
-    if placements.len() > 1 && placed > MAX_PLACED_TRIANGLES {
-        return Err(format!(
-            "{shown}: {faces} triangles placed {} times are {placed} triangles, more than the \
-             {MAX_PLACED_TRIANGLES} one mesh's instances may place (instances are copied into \
-             the scene's triangles)",
-            placements.len()
-        ));
-    }
-    let mut triangles = Vec::new();
-    let mut degenerate = 0usize;
+    // Each part checked and given its scene material, in the file's order; a geometry used
+    // by many parts is checked once.
+    let mut prepared: Vec<PreparedPart> = Vec::with_capacity(file.parts.len());
     let mut checked = std::collections::HashSet::new();
     let mut tangent_cache: std::collections::HashMap<*const Geometry, Rc<Vec<[Vec4; 3]>>> =
         std::collections::HashMap::new();
-    // Placement after placement, each with every part in the file's order: one placement is
-    // exactly the mesh without instances.
-    for (scene_matrix, part) in placements
-        .iter()
-        .flat_map(|m| file.parts.iter().map(move |p| (m, p)))
-    {
-        let matrix = *scene_matrix * part.transform;
-        // Normals go through the inverse transpose of the linear part.
-        let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
+    for part in &file.parts {
         let geometry = &*part.geometry;
-        // A geometry placed by many glTF nodes is checked once.
         let first_use = checked.insert(Rc::as_ptr(&part.geometry));
-        for (i, p) in geometry.positions.iter().enumerate().filter(|_| first_use) {
-            if !p.is_finite() {
+        let count = geometry.positions.len();
+        if first_use {
+            if let Some(i) = geometry.positions.iter().position(|p| !p.is_finite()) {
                 return Err(format!(
-                    "{shown}: {}vertex {i} is not finite: {p}",
-                    part_prefix(&part.name)
+                    "{shown}: {}vertex {i} is not finite: {}",
+                    part_prefix(&part.name),
+                    geometry.positions[i]
                 ));
+            }
+            for (f, idx) in geometry.indices.iter().enumerate() {
+                if let Some(&bad) = idx.iter().find(|&&i| i as usize >= count) {
+                    return Err(format!(
+                        "{shown}: {}face {f} refers to vertex {bad}, but there are only {count} vertices",
+                        part_prefix(&part.name)
+                    ));
+                }
             }
         }
         let use_normals = smooth && !geometry.normals.is_empty();
@@ -390,7 +391,6 @@ pub(crate) fn load_placed(
                 }
             }
         };
-        let count = geometry.positions.len();
         // Normal maps (the coat's too) need tangents at every corner (tangents.rs), read or
         // made once per geometry.
         let corners = if scene_materials[material as usize].has_normal_map() {
@@ -414,56 +414,93 @@ pub(crate) fn load_placed(
         } else {
             None
         };
-        let linear = Mat3::from_mat4(matrix);
-        for (f, idx) in geometry.indices.iter().enumerate() {
-            if let Some(&bad) = idx.iter().find(|&&i| i as usize >= count) {
-                return Err(format!(
-                    "{shown}: {}face {f} refers to vertex {bad}, but there are only {count} vertices",
-                    part_prefix(&part.name)
-                ));
-            }
-            let v = idx.map(|i| matrix.transform_point3(geometry.positions[i as usize]));
-            let cross = (v[1] - v[0]).cross(v[2] - v[0]);
-            let area2 = cross.length();
-            if area2.is_nan() || area2 <= 0.0 || !area2.is_finite() {
-                if !v.iter().all(|p| p.is_finite()) {
-                    return Err(format!(
-                        "{shown}: {}face {f} is not finite after the transform",
-                        part_prefix(&part.name)
-                    ));
-                }
-                degenerate += 1;
-                continue;
-            }
-            let normals = use_normals
-                .then(|| {
-                    idx.map(|i| (normal_matrix * geometry.normals[i as usize]).normalize_or_zero())
-                })
-                // A zero vertex normal cannot shade: the triangle is shaded flat.
-                .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
-            let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
-            let uvs1 =
-                (geometry.uvs1.len() == count).then(|| idx.map(|i| geometry.uvs1[i as usize]));
-            let colors =
-                (geometry.colors.len() == count).then(|| idx.map(|i| geometry.colors[i as usize]));
-            let tangents = corners
-                .as_ref()
-                .and_then(|c| c.get(f))
-                .map(|c| c.map(|t| tangents::placed_tangent(&linear, t)));
-            triangles.push(Triangle {
-                vertices: v,
-                normals,
-                material,
-                uvs,
-                uvs1,
-                tangents,
-                colors,
-            });
+        prepared.push(PreparedPart {
+            material,
+            use_normals,
+            corners,
+        });
+    }
+
+    let two_level: Vec<bool> = prepared
+        .iter()
+        .map(|p| scene_materials[p.material as usize].two_level())
+        .collect();
+    let plan =
+        reuse::plan(&file.parts, placements, &two_level).map_err(|e| format!("{shown}: {e}"))?;
+    // Copies are counted before any is made: many placements of a large file would otherwise
+    // fill the memory before the count is seen.
+    let faces: usize = file
+        .parts
+        .iter()
+        .zip(&plan.copied)
+        .filter(|(_, copied)| **copied)
+        .map(|(p, _)| p.geometry.indices.len())
+        .sum();
+    let copies = faces.saturating_mul(placements.len());
+    // The copied geometry's own triangles, each geometry once: more than those are copies.
+    let mut seen = std::collections::HashSet::new();
+    let copied_once: usize = file
+        .parts
+        .iter()
+        .zip(&plan.copied)
+        .filter(|(p, copied)| **copied && seen.insert(Rc::as_ptr(&p.geometry)))
+        .map(|(p, _)| p.geometry.indices.len())
+        .sum();
+    if copies > MAX_PLACED_TRIANGLES && copies > copied_once {
+        return Err(format!(
+            "{shown}: {faces} triangles to copy (a mesh the file reuses counted at each use) \
+             placed {} time{} are {copies} triangles, more than the {MAX_PLACED_TRIANGLES} one \
+             mesh entry may copy; triangles are copied when their material emits light, is \
+             alpha-tested or blended, or has a normal map (the two-level structure holds none \
+             of those)",
+            placements.len(),
+            if placements.len() == 1 { "" } else { "s" }
+        ));
+    }
+    let mut triangles = Vec::new();
+    let mut degenerate = 0usize;
+    let too_many =
+        || format!("{shown}: more than {MAX_TRIANGLES} triangles; glint holds at most that many");
+    // Placement after placement, each with every copied part in the file's order: one
+    // placement is exactly the mesh without instances.
+    for scene_matrix in placements {
+        for (p, part) in file
+            .parts
+            .iter()
+            .enumerate()
+            .filter(|(p, _)| plan.copied[*p])
+        {
+            place_part(
+                part,
+                &prepared[p],
+                *scene_matrix * part.transform,
+                &mut triangles,
+                &mut degenerate,
+            )
+            .map_err(|f| not_finite(shown, part, f))?;
             if triangles.len() > MAX_TRIANGLES {
-                return Err(format!(
-                    "{shown}: more than {MAX_TRIANGLES} triangles; glint holds at most that many"
-                ));
+                return Err(too_many());
             }
+        }
+    }
+    let mut instanced = Vec::new();
+    let mut stored = 0usize;
+    for unit in plan.stored_once {
+        let mut own = Vec::new();
+        for (p, matrix) in unit.members {
+            let part = &file.parts[p];
+            place_part(part, &prepared[p], matrix, &mut own, &mut degenerate)
+                .map_err(|f| not_finite(shown, part, f))?;
+        }
+        stored += own.len();
+        if triangles.len() + stored > MAX_TRIANGLES {
+            return Err(too_many());
+        }
+        if !own.is_empty() {
+            instanced.push(InstancedMesh {
+                triangles: own,
+                placements: unit.placements,
+            });
         }
     }
     if degenerate > 0 {
@@ -472,7 +509,7 @@ pub(crate) fn load_placed(
             if degenerate == 1 { "" } else { "s" }
         ));
     }
-    if triangles.is_empty() {
+    if triangles.is_empty() && instanced.is_empty() {
         return Err(format!(
             "{shown}: the mesh has no triangles{}",
             if degenerate > 0 {
@@ -484,8 +521,81 @@ pub(crate) fn load_placed(
     }
     Ok(LoadedMesh {
         triangles,
+        instanced,
         warnings,
     })
+}
+
+/// What placing a part needs besides its geometry and matrix, found once per part.
+struct PreparedPart {
+    material: u32,
+    /// Whether its triangles are shaded smooth with the file's vertex normals.
+    use_normals: bool,
+    /// Per triangle, the tangent at each corner (for normal maps).
+    corners: Option<Rc<Vec<[Vec4; 3]>>>,
+}
+
+/// Adds `part`'s triangles, moved by `matrix`, to `out`; those of zero area after the move
+/// are skipped and counted in `degenerate`. A triangle that is not finite after the move is an
+/// error: its index.
+fn place_part(
+    part: &MeshPart,
+    prepared: &PreparedPart,
+    matrix: Mat4,
+    out: &mut Vec<Triangle>,
+    degenerate: &mut usize,
+) -> Result<(), usize> {
+    let geometry = &*part.geometry;
+    let count = geometry.positions.len();
+    // Normals go through the inverse transpose of the linear part.
+    let normal_matrix = Mat3::from_mat4(matrix).inverse().transpose();
+    let linear = Mat3::from_mat4(matrix);
+    for (f, idx) in geometry.indices.iter().enumerate() {
+        let v = idx.map(|i| matrix.transform_point3(geometry.positions[i as usize]));
+        let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+        let area2 = cross.length();
+        if area2.is_nan() || area2 <= 0.0 || !area2.is_finite() {
+            if !v.iter().all(|p| p.is_finite()) {
+                return Err(f);
+            }
+            *degenerate += 1;
+            continue;
+        }
+        let normals = prepared
+            .use_normals
+            .then(|| {
+                idx.map(|i| (normal_matrix * geometry.normals[i as usize]).normalize_or_zero())
+            })
+            // A zero vertex normal cannot shade: the triangle is shaded flat.
+            .filter(|n| n.iter().all(|n| *n != Vec3::ZERO));
+        let uvs = (geometry.uvs.len() == count).then(|| idx.map(|i| geometry.uvs[i as usize]));
+        let uvs1 = (geometry.uvs1.len() == count).then(|| idx.map(|i| geometry.uvs1[i as usize]));
+        let colors =
+            (geometry.colors.len() == count).then(|| idx.map(|i| geometry.colors[i as usize]));
+        let tangents = prepared
+            .corners
+            .as_ref()
+            .and_then(|c| c.get(f))
+            .map(|c| c.map(|t| tangents::placed_tangent(&linear, t)));
+        out.push(Triangle {
+            vertices: v,
+            normals,
+            material: prepared.material,
+            uvs,
+            uvs1,
+            tangents,
+            colors,
+        });
+    }
+    Ok(())
+}
+
+/// The error for face `face` of `part`, not finite once placed.
+fn not_finite(shown: &str, part: &MeshPart, face: usize) -> String {
+    format!(
+        "{shown}: {}face {face} is not finite after the transform",
+        part_prefix(&part.name)
+    )
 }
 
 /// The texture of an image a mesh file's material refers to; the error names the material

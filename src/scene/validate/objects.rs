@@ -16,7 +16,7 @@ pub(super) struct Objects {
     pub(super) spheres: Vec<Sphere>,
     pub(super) quads: Vec<Quad>,
     pub(super) triangles: Vec<Triangle>,
-    /// Meshes placed many times and stored once (see [`two_level`]).
+    /// Meshes placed many times and stored once (see `Material::two_level`).
     pub(super) instanced: Vec<InstancedMesh>,
     /// The punctual lights of glTF files (`[[meshes]] lights`, default true).
     pub(super) lights: Vec<Light>,
@@ -147,36 +147,19 @@ pub(super) fn validate_objects(
             translate,
         };
         // The mesh's own transform first, then each instance's.
-        let instance_matrices: Option<Vec<Mat4>> = match &m.instances {
-            None => None,
-            Some(list) => Some(
-                instances(list, &field("instances"))?
-                    .iter()
-                    .map(MeshTransform::matrix)
-                    .collect(),
-            ),
-        };
-        let placements: Vec<Mat4> = match &instance_matrices {
+        let placements: Vec<Mat4> = match &m.instances {
             None => vec![transform.matrix()],
-            Some(list) => list.iter().map(|i| *i * transform.matrix()).collect(),
+            Some(list) => instances(list, &field("instances"))?
+                .iter()
+                .map(|i| i.matrix() * transform.matrix())
+                .collect(),
         };
-        // Stored once (the two-level structure) when it has two or more instances and the
-        // material named here, if any, allows it (a file's own materials are known only once
-        // it is read). Two: from there on a copy saves memory, whatever the mesh's size, and
-        // the rule is one a user can predict; a single instance is just the mesh placed, so
-        // it stays in the scene's triangles, which no ray has to transform into.
-        let once = instance_matrices.as_ref().filter(|list| {
-            list.len() >= 2 && material.is_none_or(|id| two_level(&materials.list[id as usize]))
-        });
-        let object_space = [transform.matrix()];
+        // What is placed two or more times (by `instances` or by the file itself) comes back
+        // stored once where its materials allow (src/scene/mesh/reuse.rs), the rest copied.
         let loaded = mesh::load_placed(
             &folder.join(file),
             file,
-            if once.is_some() {
-                &object_space
-            } else {
-                &placements
-            },
+            &placements,
             material,
             m.smooth.unwrap_or(true),
             &mut materials.list,
@@ -184,52 +167,26 @@ pub(super) fn validate_objects(
         )
         .or_else(|message| fail(m.file.span(), field("file"), message))?;
         warnings.extend(loaded.warnings);
-        match once {
-            None => triangles.extend(loaded.triangles),
-            Some(list)
-                if loaded
-                    .triangles
-                    .iter()
-                    .all(|t| two_level(&materials.list[t.material as usize])) =>
-            {
-                unique_triangles += loaded.triangles.len();
-                instance_count += list.len();
-                if instance_count > MAX_INSTANCES {
-                    return fail(
-                        list_span(m),
-                        field("instances"),
-                        format!(
-                            "the scene's meshes have more than {MAX_INSTANCES} instances in all, \
-                             more than one GPU binding of 128 MiB holds the transforms of"
-                        ),
-                    );
-                }
-                instanced.push(InstancedMesh {
-                    triangles: loaded.triangles,
-                    placements: list.clone(),
-                });
+        triangles.extend(loaded.triangles);
+        for mesh in loaded.instanced {
+            unique_triangles += mesh.triangles.len();
+            instance_count += mesh.placements.len();
+            if instance_count > mesh::MAX_INSTANCES {
+                let (span, name) = match &m.instances {
+                    Some(list) => (list.span(), field("instances")),
+                    None => (m.file.span(), field("file")),
+                };
+                return fail(
+                    span,
+                    name,
+                    format!(
+                        "the scene's meshes have more than {} instances in all, more than one \
+                         GPU binding of 128 MiB holds the transforms of",
+                        mesh::MAX_INSTANCES
+                    ),
+                );
             }
-            // The file's own materials emit, cut holes or map normals: copied per instance.
-            Some(list) => {
-                if loaded.triangles.len().saturating_mul(list.len()) > mesh::MAX_PLACED_TRIANGLES {
-                    return fail(
-                        m.file.span(),
-                        field("file"),
-                        format!(
-                            "{file}: {} triangles placed {} times are more than the {} one \
-                             mesh's instances may place when its materials emit light, are \
-                             alpha-tested or blended, or have a normal map (such instances are \
-                             copied into the scene's triangles)",
-                            loaded.triangles.len(),
-                            list.len(),
-                            mesh::MAX_PLACED_TRIANGLES
-                        ),
-                    );
-                }
-                for instance in list {
-                    triangles.extend(loaded.triangles.iter().map(|t| mesh::placed(t, instance)));
-                }
-            }
+            instanced.push(mesh);
         }
         if m.lights.unwrap_or(true) && mesh::is_gltf(Path::new(file)) {
             for (p, placement) in placements.iter().enumerate() {
@@ -267,28 +224,6 @@ pub(super) fn validate_objects(
         lights,
         warnings,
     })
-}
-
-/// The most instances a scene's instanced meshes may have in all: their transforms
-/// (`shader_types::Instance`, 112 bytes each) fill one 128 MiB binding at about 1.2·10⁶.
-pub const MAX_INSTANCES: usize = 1 << 20;
-
-/// Whether a mesh in `material` may be stored once and placed by transforms (the two-level
-/// structure), rather than copied per instance. Not when it emits: light sampling picks
-/// emitting triangles by their power in the scene's coordinates, one table entry per placed
-/// triangle (src/scene/kernel.rs), which an instance would have to sample through its
-/// transform. Not when alpha-tested or blended, nor with a normal map: the alpha test and the
-/// tangent frame would need the instance too. Those are copied as before, which is exact.
-fn two_level(material: &Material) -> bool {
-    material.emitted_radiance == Vec3::ZERO
-        && material.emission_texture.is_none()
-        && material.alpha.mode == AlphaMode::Opaque
-        && !material.has_normal_map()
-}
-
-/// Where `[[meshes]] instances` is in the file.
-fn list_span(m: &MeshToml) -> Range<usize> {
-    m.instances.as_ref().map_or(m.file.span(), |l| l.span())
 }
 
 /// A scale factor per axis, each finite and > 0 (a mesh's `scale` or an instance's).
