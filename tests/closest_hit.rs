@@ -61,6 +61,12 @@ fn load(dir: &std::path::Path, toml: &str) -> Scene {
 /// Coincident copies of everything, interleaved and with alternating materials, among a
 /// displaced sphere mesh: 3 spheres, 3 quads and a cube mesh, each 20 times in place.
 fn copies_scene(dir: &std::path::Path) -> KernelScene {
+    load(dir, &copies_toml(dir, true)).kernel_scene()
+}
+
+/// [`copies_scene`]'s file, its cube's copies flattened (`[[meshes]]` entries) or, without
+/// `flattened`, one entry's 20 coincident instances in white (stored once, src/scene/kernel.rs).
+fn copies_toml(dir: &std::path::Path, flattened: bool) -> String {
     std::fs::write(dir.join("cube.obj"), CUBE_OBJ).unwrap();
     StressMesh::new(24, 12)
         .write_ply(&dir.join("mesh.ply"))
@@ -89,9 +95,15 @@ fn copies_scene(dir: &std::path::Path) -> KernelScene {
                 "[[quads]]\ncorner = {corner:?}\nu = {u:?}\nv = {v:?}\nmaterial = \"{material}\"\n"
             );
         }
-        toml += &format!("[[meshes]]\nfile = \"cube.obj\"\nmaterial = \"{material}\"\nscale = 1.2\ntranslate = [-1.0, 1.0, -1.0]\n");
+        if flattened {
+            toml += &format!("[[meshes]]\nfile = \"cube.obj\"\nmaterial = \"{material}\"\nscale = 1.2\ntranslate = [-1.0, 1.0, -1.0]\n");
+        }
     }
-    load(dir, &toml).kernel_scene()
+    if !flattened {
+        let instances = vec!["{}"; COPIES].join(", ");
+        toml += &format!("[[meshes]]\nfile = \"cube.obj\"\nmaterial = \"white\"\nscale = 1.2\ntranslate = [-1.0, 1.0, -1.0]\ninstances = [{instances}]\n");
+    }
+    toml
 }
 
 /// 2000 concentric spheres whose radii differ by a little: a stack the builder makes a chain of
@@ -420,4 +432,19 @@ fn hardware_traversal_finds_the_closest_of_a_deep_stack() {
     let scene = stack_scene(dir.path());
     let hits = check_gpu(ctx, &scene, [1; 3], GpuTraversal::Hardware);
     assert!(hits > GPU_RAYS * 3 / 10, "{hits}");
+}
+
+/// The same with the cube as 20 coincident instances of one mesh (one TLAS instance per
+/// placement over one BLAS): the hardware proposes the placements' candidates in its own
+/// order, and the hit must be the scan's, through instance 0 (the probe flags any other).
+#[test]
+fn hardware_traversal_finds_the_lowest_of_coincident_instances() {
+    let Some(ctx) = gpu_with_ray_queries() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = load(dir.path(), &copies_toml(dir.path(), false)).kernel_scene();
+    assert_eq!(scene.instances.len(), COPIES);
+    let hits = check_gpu(ctx, &scene, COPY_STRIDE, GpuTraversal::Hardware);
+    assert!(hits > GPU_RAYS / 2, "{hits}");
 }

@@ -1,11 +1,14 @@
 // Hardware traversal with ray queries (wgpu's EXPERIMENTAL_RAY_QUERY), compiled only into the
 // hardware kernel variant (SceneBinding::Hardware in src/shader.rs): a shader that uses ray
 // queries does not compile on a device without them. The host builds the acceleration
-// structure (src/gpu/acceleration.rs): a TLAS over two BLASes, the triangles as triangle
-// geometry and the spheres and quads as boxes. The hardware only proposes candidates: every
-// one, triangles included (RAY_FLAG_FORCE_NO_OPAQUE), is tested here with glint's own exact
-// test (hit_primitive, shaders/bvh.wgsl) and kept by the closest-hit rule (hit_comes_first),
-// so a hit's t and primitive are the software traversal's. That test includes alpha
+// structure (src/gpu/acceleration.rs): a TLAS over the triangles placed as they are (triangle
+// geometry), the spheres and quads (boxes), and one instance per placement of an instanced
+// mesh, over that mesh's triangles in its own coordinates. The hardware only proposes
+// candidates: every one, triangles included (RAY_FLAG_FORCE_NO_OPAQUE), is tested here with
+// glint's own exact test (hit_primitive, shaders/bvh.wgsl; an instance's triangle in the
+// instance's coordinates, as shaders/traverse/blas.wgsl tests it) and kept by the closest-hit
+// rule (hit_comes_first, extended by triangle within an instance), so a hit's t, primitive and
+// instance are the software traversal's. That test includes alpha
 // (hit_scene_triangle, shaders/alpha.wgsl): a candidate in a hole, or that a blended triangle
 // lets through, is rejected like a miss, so no geometry needs other flags for alpha. No CPU mirror: the CPU traces with
 // the software BVH (src/cpu/bvh.rs), which this must agree with (tests/closest_hit.rs).
@@ -13,7 +16,9 @@
 @group(0) @binding(26) var scene_tlas: acceleration_structure;
 // The reference ((kind << PRIMITIVE_KIND_SHIFT) | index) of every primitive in the TLAS: a
 // candidate's is at its instance's custom data (where its BLAS's references start) plus its
-// primitive index.
+// primitive index. An instanced mesh's triangles are those past the ones placed as they are
+// (triangle_count()); the placements take the TLAS's first slots, so such a candidate is hit
+// through the instance whose index is its TLAS instance index.
 @group(0) @binding(27) var<storage, read> hardware_references: array<u32>;
 
 // How much further than a hit the hardware is asked to look, relatively: 2^-12, far more than
@@ -50,12 +55,29 @@ fn hardware_traverse(ray: Ray, t_max: f32, max_reference: u32, shadow_target: u3
                 break;
             }
             let candidate = rayQueryGetCandidateIntersection(&rq);
-            let reference = hardware_references[candidate.instance_custom_data + candidate.primitive_index];
-            let t = hit_primitive(reference, r);
-            if !hit_comes_first(t, reference, best.t, best_reference) || reference == shadow_target {
+            var reference = hardware_references[candidate.instance_custom_data + candidate.primitive_index];
+            var index = reference & PRIMITIVE_INDEX_MASK;
+            var instance = NO_INSTANCE;
+            var t: f32;
+            var first: bool;
+            if HAS_INSTANCES && (reference >> PRIMITIVE_KIND_SHIFT) == PRIMITIVE_TRIANGLE && index >= triangle_count() {
+                // Tested as blas.wgsl tests it, and ordered as the software traversal orders
+                // it: by the instance's reference, then among one instance's triangles by index.
+                instance = candidate.instance_index;
+                t = hit_scene_triangle(index, triangle_ray(object_ray(instances[instance], ray)));
+                reference = (PRIMITIVE_INSTANCE << PRIMITIVE_KIND_SHIFT) | instance;
+                first = hit_comes_first(t, reference, best.t, best_reference)
+                    || (t == best.t && reference == best_reference && index < best.index);
+            } else {
+                t = hit_primitive(reference, r);
+                // The target is excluded by name too (as in bvh_traverse); an instance's
+                // triangle never is one (no light is hit through an instance).
+                first = hit_comes_first(t, reference, best.t, best_reference) && reference != shadow_target;
+            }
+            if !first {
                 continue;
             }
-            best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK, NO_INSTANCE);
+            best = ClosestPrimitive(t, select(reference >> PRIMITIVE_KIND_SHIFT, PRIMITIVE_TRIANGLE, instance != NO_INSTANCE), index, instance);
             best_reference = reference;
             found = true;
             if shadow_target != NO_PRIMITIVE {

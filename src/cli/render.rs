@@ -212,7 +212,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let gpu = open_gpu(&args)?;
     // The CPU reference traverses its BVH whatever --traversal says.
     let traversal = match &gpu {
-        Some(ctx) => Some(args.traversal.resolve_for(ctx, &kernel_scene)?),
+        Some(ctx) => Some(args.traversal.resolve(ctx)?),
         None => None,
     };
     let mut renderer: Box<dyn Renderer + '_> = match (&gpu, traversal) {

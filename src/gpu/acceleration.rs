@@ -1,15 +1,18 @@
 //! The acceleration structure the hardware traversal (`shaders/traverse/hardware.wgsl`)
-//! traces with ray queries: a TLAS over at most two BLASes, one of triangle geometry holding
-//! the scene's triangles and one of box (AABB) geometry holding its spheres and quads, whose
-//! candidates the kernel tests with glint's own exact tests. Each primitive's reference
-//! ((kind << PRIMITIVE_KIND_SHIFT) | index) is in one buffer, where a candidate's is at its
-//! instance's custom data plus its primitive index.
+//! traces with ray queries: a TLAS over triangle geometry holding the triangles placed as they
+//! are, box (AABB) geometry holding the spheres and quads, and one triangle BLAS per instanced
+//! mesh (its triangles in its own coordinates, stored once) with one TLAS instance per
+//! placement, transformed by the placement. The kernel tests every candidate with glint's own
+//! exact tests. Each primitive's reference ((kind << PRIMITIVE_KIND_SHIFT) | index) is in one
+//! buffer, where a candidate's is at its instance's custom data plus its primitive index; the
+//! placements take the TLAS's first slots, so a candidate on a placement's mesh is hit through
+//! the instance whose index is its TLAS instance index.
 
 use super::context::GpuContext;
 use crate::scene::KernelScene;
 use crate::shader_types::{
-    PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
-    PRIMITIVE_TRIANGLE,
+    PRIMITIVE_INDEX_MASK, PRIMITIVE_INSTANCE, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use anyhow::{anyhow, Result};
 use glam::Vec3;
@@ -18,13 +21,25 @@ use wgpu::util::DeviceExt;
 /// The scene's primitives as the hardware takes them, before upload.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct HardwareGeometry {
-    /// Three vertices per triangle (no index buffer), in `triangle_references`' order: each
-    /// triangle widened in its plane ([`widened_triangle`]).
+    /// Three vertices per triangle placed as it is (no index buffer), in
+    /// `triangle_references`' order: each triangle widened in its plane ([`widened_triangle`]).
     pub vertices: Vec<[f32; 3]>,
     pub triangle_references: Vec<u32>,
     /// (min, max) per sphere or quad, in `box_references`' order.
     pub boxes: Vec<[f32; 6]>,
     pub box_references: Vec<u32>,
+    /// Each instanced mesh once, in its own coordinates, in the kernel's order.
+    pub meshes: Vec<MeshGeometry>,
+    /// Per instance (in `KernelScene::instances`' order): its mesh's index in `meshes`.
+    pub instance_meshes: Vec<usize>,
+}
+
+/// An instanced mesh's triangles as its BLAS takes them: widened like the others, in its own
+/// coordinates, with their references (triangle indices in the kernel's arrays).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshGeometry {
+    pub vertices: Vec<[f32; 3]>,
+    pub triangle_references: Vec<u32>,
 }
 
 /// How much each box is widened on every side, relative to the size of its coordinates and
@@ -71,8 +86,9 @@ pub fn widened_triangle(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [[f32; 3]; 3] 
 
 impl HardwareGeometry {
     /// The primitives the traversal must see: those of the scene's BVH where it has one (all
-    /// but exact copies, which by the closest-hit rule no ray sees: src/scene/bvh.rs), else
-    /// every sphere and quad (a scene without a BVH has no triangles).
+    /// but exact copies, which by the closest-hit rule no ray sees: src/scene/bvh.rs; an
+    /// instanced mesh's, those of its own BVH, without its copies), else every sphere and quad
+    /// (a scene without a BVH has no triangles).
     pub fn of(scene: &KernelScene) -> HardwareGeometry {
         let references: Vec<u32> = if scene.bvh_primitives.is_empty() {
             let spheres = (0..scene.spheres.len() as u32)
@@ -86,9 +102,29 @@ impl HardwareGeometry {
             sorted
         };
         let mut geometry = HardwareGeometry::default();
+        // The meshes' first triangles, in order (the kernel lays the meshes out one after
+        // another, each placed by consecutive instances).
+        let mut mesh_starts: Vec<u32> = Vec::new();
+        for instance in &scene.instances {
+            if mesh_starts.last() != Some(&instance.first_triangle) {
+                mesh_starts.push(instance.first_triangle);
+                geometry.meshes.push(MeshGeometry::default());
+            }
+            geometry.instance_meshes.push(mesh_starts.len() - 1);
+        }
+        let own_triangles = mesh_starts.first().map_or(u32::MAX, |&first| first);
         for reference in references {
             let index = (reference & PRIMITIVE_INDEX_MASK) as usize;
             match reference >> PRIMITIVE_KIND_SHIFT {
+                // The instances themselves are the TLAS's placements.
+                PRIMITIVE_INSTANCE => {}
+                PRIMITIVE_TRIANGLE if index as u32 >= own_triangles => {
+                    let mesh = mesh_starts.partition_point(|&first| first <= index as u32) - 1;
+                    let t = &scene.triangles[index];
+                    let m = &mut geometry.meshes[mesh];
+                    m.vertices.extend(widened_triangle(t.v0, t.v1, t.v2));
+                    m.triangle_references.push(reference);
+                }
                 PRIMITIVE_TRIANGLE => {
                     let t = &scene.triangles[index];
                     geometry.vertices.extend(widened_triangle(t.v0, t.v1, t.v2));
@@ -115,12 +151,28 @@ impl HardwareGeometry {
         geometry
     }
 
-    /// Every reference: the triangles', then the boxes' (where the box instance's custom data
-    /// points).
+    /// Every reference: the triangles', then the boxes', then each mesh's.
     pub fn references(&self) -> Vec<u32> {
         let mut all = self.triangle_references.clone();
         all.extend(&self.box_references);
+        for mesh in &self.meshes {
+            all.extend(&mesh.triangle_references);
+        }
         all
+    }
+
+    /// Where each mesh's references start in [`HardwareGeometry::references`]: the custom
+    /// data of its placements.
+    pub fn mesh_reference_starts(&self) -> Vec<usize> {
+        let mut next = self.triangle_references.len() + self.box_references.len();
+        self.meshes
+            .iter()
+            .map(|mesh| {
+                let start = next;
+                next += mesh.triangle_references.len();
+                start
+            })
+            .collect()
     }
 }
 
@@ -136,31 +188,28 @@ pub struct AccelerationStructure {
     pub build_seconds: f64,
 }
 
-/// The row-major 3×4 identity: the instances are in world space.
+/// The row-major 3×4 identity: the triangles placed as they are, and the boxes, are in world
+/// space.
 const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 
 /// The instance custom data holds 24 bits.
 const MAX_CUSTOM_DATA: usize = (1 << 24) - 1;
 
+/// What one BLAS holds, before upload.
+enum BlasInput<'a> {
+    /// Three widened vertices per triangle.
+    Triangles(&'a [[f32; 3]]),
+    Boxes(&'a [[f32; 6]]),
+}
+
 /// Builds `scene`'s acceleration structure on `ctx`'s device, which must have ray queries.
 /// A scene over the device's limits is an error naming the limit.
-/// Why a scene with instances cannot take the hardware traversal: its acceleration structure
-/// would need an instance level of its own (a TLAS instance per placement over one BLAS per
-/// mesh), which is not built yet, and tracing the stored triangles as they are would draw each
-/// mesh once, in its own coordinates: a wrong image. The software traversal traces them.
-pub const INSTANCES_UNSUPPORTED: &str = "the scene has instanced meshes ([[meshes]] instances), \
-     which the hardware traversal (ray queries) does not trace yet; use --traversal software or \
-     auto";
-
 pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStructure> {
     if !ctx.has_ray_queries() {
         return Err(anyhow!(
             "{} has no ray queries (wgpu's EXPERIMENTAL_RAY_QUERY), which the hardware traversal needs",
             ctx.device_name()
         ));
-    }
-    if !scene.instances.is_empty() {
-        return Err(anyhow!("{INSTANCES_UNSUPPORTED}"));
     }
     let started = std::time::Instant::now();
     let device = &ctx.device;
@@ -169,7 +218,17 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
     let triangles = geometry.triangle_references.len();
     let boxes = geometry.boxes.len();
     let most = limits.max_blas_primitive_count as usize;
-    for (count, what) in [(triangles, "triangles"), (boxes, "spheres and quads")] {
+    let largest_mesh = geometry
+        .meshes
+        .iter()
+        .map(|m| m.triangle_references.len())
+        .max()
+        .unwrap_or(0);
+    for (count, what) in [
+        (triangles, "triangles"),
+        (boxes, "spheres and quads"),
+        (largest_mesh, "triangles of one instanced mesh"),
+    ] {
         if count > most {
             return Err(anyhow!(
                 "the scene's {count} {what} are more than {} allows in one acceleration structure \
@@ -178,10 +237,54 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
             ));
         }
     }
-    if triangles > MAX_CUSTOM_DATA {
+    let references = geometry.references();
+    if references.len() > MAX_CUSTOM_DATA {
         return Err(anyhow!(
-            "the scene's {triangles} triangles are more than the hardware traversal can reference \
-             ({MAX_CUSTOM_DATA}); use --traversal software"
+            "the scene's {} primitives (its instanced meshes' counted once) are more than the \
+             hardware traversal can reference ({MAX_CUSTOM_DATA}); use --traversal software",
+            references.len()
+        ));
+    }
+    // An empty scene still needs an instance: one box BLAS holding one inactive box (NaN).
+    let mut boxes_in = geometry.boxes.clone();
+    if boxes_in.is_empty() && triangles == 0 && scene.instances.is_empty() {
+        boxes_in.push([f32::NAN; 6]);
+    }
+    // (what it holds, its instances' custom data); the meshes first, so that the placements,
+    // which take the TLAS's first slots, are in the instances' order.
+    let mut blas_inputs: Vec<(BlasInput, u32)> = Vec::new();
+    let mesh_starts = geometry.mesh_reference_starts();
+    for (mesh, &start) in geometry.meshes.iter().zip(&mesh_starts) {
+        blas_inputs.push((BlasInput::Triangles(&mesh.vertices), start as u32));
+    }
+    if triangles > 0 {
+        blas_inputs.push((BlasInput::Triangles(&geometry.vertices), 0));
+    }
+    if !boxes_in.is_empty() {
+        blas_inputs.push((BlasInput::Boxes(&boxes_in), triangles as u32));
+    }
+    // (BLAS index, row-major 3×4 transform, custom data) per TLAS instance: the placements,
+    // then the world-space BLASes.
+    let mut tlas_instances: Vec<(usize, [f32; 12], u32)> = scene
+        .instances
+        .iter()
+        .zip(&geometry.instance_meshes)
+        .map(|(instance, &mesh)| {
+            let transform: [f32; 12] = bytemuck::cast(instance.to_world);
+            (mesh, transform, blas_inputs[mesh].1)
+        })
+        .collect();
+    for (blas, input) in blas_inputs.iter().enumerate().skip(geometry.meshes.len()) {
+        tlas_instances.push((blas, IDENTITY, input.1));
+    }
+    let most_instances = limits.max_tlas_instance_count as usize;
+    if tlas_instances.len() > most_instances {
+        return Err(anyhow!(
+            "the scene's {} instances (and {} world-space structures) are more than {} allows in \
+             one acceleration structure ({most_instances} instances); use --traversal software",
+            scene.instances.len(),
+            tlas_instances.len() - scene.instances.len(),
+            ctx.device_name()
         ));
     }
     let flags = wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE;
@@ -190,106 +293,113 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
         flags,
         update_mode: wgpu::AccelerationStructureUpdateMode::Build,
     };
-    let input = |label: &str, contents: &[u8]| {
+    let input_buffer = |label: &str, contents: &[u8]| {
         device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
             contents,
             usage: wgpu::BufferUsages::BLAS_INPUT,
         })
     };
-    // An empty scene still needs an instance: one box BLAS holding one inactive box (NaN).
-    let mut boxes_in = geometry.boxes.clone();
-    if boxes_in.is_empty() && triangles == 0 {
-        boxes_in.push([f32::NAN; 6]);
+    let opaque = wgpu::AccelerationStructureGeometryFlags::OPAQUE;
+    let mut triangle_sizes = Vec::new();
+    let mut box_sizes = Vec::new();
+    for (input, _) in &blas_inputs {
+        match input {
+            BlasInput::Triangles(vertices) => {
+                triangle_sizes.push(wgpu::BlasTriangleGeometrySizeDescriptor {
+                    vertex_format: wgpu::VertexFormat::Float32x3,
+                    vertex_count: vertices.len() as u32,
+                    index_format: None,
+                    index_count: None,
+                    flags: opaque,
+                })
+            }
+            BlasInput::Boxes(boxes) => box_sizes.push(wgpu::BlasAABBGeometrySizeDescriptor {
+                primitive_count: boxes.len() as u32,
+                flags: opaque,
+            }),
+        }
     }
-    let triangle_size = wgpu::BlasTriangleGeometrySizeDescriptor {
-        vertex_format: wgpu::VertexFormat::Float32x3,
-        vertex_count: geometry.vertices.len() as u32,
-        index_format: None,
-        index_count: None,
-        flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
-    };
-    let box_size = wgpu::BlasAABBGeometrySizeDescriptor {
-        primitive_count: boxes_in.len() as u32,
-        flags: wgpu::AccelerationStructureGeometryFlags::OPAQUE,
-    };
     let mut blases = Vec::new();
     let mut inputs = Vec::new();
-    // (BLAS index, custom data) per instance.
-    let mut instances = Vec::new();
-    if triangles > 0 {
-        blases.push(device.create_blas(
-            &blas_descriptor,
-            wgpu::BlasGeometrySizeDescriptors::Triangles {
-                descriptors: vec![triangle_size.clone()],
-            },
-        ));
-        inputs.push(input(
-            "BLAS vertices",
-            bytemuck::cast_slice(&geometry.vertices),
-        ));
-        instances.push((blases.len() - 1, 0u32));
-    }
-    if !boxes_in.is_empty() {
-        blases.push(device.create_blas(
-            &blas_descriptor,
-            wgpu::BlasGeometrySizeDescriptors::AABBs {
-                descriptors: vec![box_size.clone()],
-            },
-        ));
-        inputs.push(input("BLAS boxes", bytemuck::cast_slice(&boxes_in)));
-        instances.push((blases.len() - 1, triangles as u32));
+    let (mut next_triangles, mut next_boxes) = (0, 0);
+    // Which size descriptor each BLAS has.
+    let mut size_of_blas = Vec::new();
+    for (input, _) in &blas_inputs {
+        let (sizes, buffer) = match input {
+            BlasInput::Triangles(vertices) => {
+                size_of_blas.push(next_triangles);
+                next_triangles += 1;
+                (
+                    wgpu::BlasGeometrySizeDescriptors::Triangles {
+                        descriptors: vec![triangle_sizes[next_triangles - 1].clone()],
+                    },
+                    input_buffer("BLAS vertices", bytemuck::cast_slice(vertices)),
+                )
+            }
+            BlasInput::Boxes(boxes) => {
+                size_of_blas.push(next_boxes);
+                next_boxes += 1;
+                (
+                    wgpu::BlasGeometrySizeDescriptors::AABBs {
+                        descriptors: vec![box_sizes[next_boxes - 1].clone()],
+                    },
+                    input_buffer("BLAS boxes", bytemuck::cast_slice(boxes)),
+                )
+            }
+        };
+        blases.push(device.create_blas(&blas_descriptor, sizes));
+        inputs.push(buffer);
     }
     let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
         label: Some("glint TLAS"),
-        max_instances: instances.len() as u32,
+        max_instances: tlas_instances.len() as u32,
         flags,
         update_mode: wgpu::AccelerationStructureUpdateMode::Build,
     });
-    for (slot, &(blas, custom_data)) in instances.iter().enumerate() {
+    for (slot, &(blas, transform, custom_data)) in tlas_instances.iter().enumerate() {
         tlas[slot] = Some(wgpu::TlasInstance::new(
             &blases[blas],
-            IDENTITY,
+            transform,
             custom_data,
             0xff,
         ));
     }
-    let mut entries = Vec::new();
-    let mut next_input = 0;
-    if triangles > 0 {
-        entries.push(wgpu::BlasBuildEntry {
-            blas: &blases[0],
-            geometry: wgpu::BlasGeometries::TriangleGeometries(vec![wgpu::BlasTriangleGeometry {
-                size: &triangle_size,
-                vertex_buffer: &inputs[0],
-                first_vertex: 0,
-                vertex_stride: size_of::<[f32; 3]>() as u64,
-                index_buffer: None,
-                first_index: None,
-                transform_buffer: None,
-                transform_buffer_offset: None,
-            }]),
-        });
-        next_input = 1;
-    }
-    if !boxes_in.is_empty() {
-        entries.push(wgpu::BlasBuildEntry {
-            blas: &blases[next_input],
-            geometry: wgpu::BlasGeometries::AabbGeometries(vec![wgpu::BlasAabbGeometry {
-                size: &box_size,
-                stride: size_of::<[f32; 6]>() as u64,
-                aabb_buffer: &inputs[next_input],
-                primitive_offset: 0,
-            }]),
-        });
-    }
+    let entries: Vec<_> = blas_inputs
+        .iter()
+        .enumerate()
+        .map(|(i, (input, _))| wgpu::BlasBuildEntry {
+            blas: &blases[i],
+            geometry: match input {
+                BlasInput::Triangles(_) => {
+                    wgpu::BlasGeometries::TriangleGeometries(vec![wgpu::BlasTriangleGeometry {
+                        size: &triangle_sizes[size_of_blas[i]],
+                        vertex_buffer: &inputs[i],
+                        first_vertex: 0,
+                        vertex_stride: size_of::<[f32; 3]>() as u64,
+                        index_buffer: None,
+                        first_index: None,
+                        transform_buffer: None,
+                        transform_buffer_offset: None,
+                    }])
+                }
+                BlasInput::Boxes(_) => {
+                    wgpu::BlasGeometries::AabbGeometries(vec![wgpu::BlasAabbGeometry {
+                        size: &box_sizes[size_of_blas[i]],
+                        stride: size_of::<[f32; 6]>() as u64,
+                        aabb_buffer: &inputs[i],
+                        primitive_offset: 0,
+                    }])
+                }
+            },
+        })
+        .collect();
     let mut encoder = device.create_command_encoder(&Default::default());
     encoder.build_acceleration_structures(entries.iter(), std::iter::once(&tlas));
     ctx.queue.submit([encoder.finish()]);
     ctx.wait_idle()
         .map_err(|e| e.context("building the acceleration structure"))?;
-    let references =
-        super::renderer::storage_buffer(ctx, "hardware references", &geometry.references());
+    let references = super::renderer::storage_buffer(ctx, "hardware references", &references);
     Ok(AccelerationStructure {
         tlas,
         references,

@@ -4,7 +4,6 @@
 //! (src/gpu/acceleration.rs). Both find the same closest hit by the closest-hit rule.
 
 use super::context::GpuContext;
-use crate::scene::KernelScene;
 use anyhow::{anyhow, Result};
 
 /// `--traversal`.
@@ -45,22 +44,6 @@ fn is_lavapipe(ctx: &GpuContext) -> bool {
 }
 
 impl TraversalChoice {
-    /// [`TraversalChoice::resolve`] for `scene`: `auto` takes the software traversal for a
-    /// scene with instances, which the hardware one does not trace yet, and `hardware` is an
-    /// error naming why (src/gpu/acceleration.rs, `INSTANCES_UNSUPPORTED`).
-    pub fn resolve_for(self, ctx: &GpuContext, scene: &KernelScene) -> Result<Traversal> {
-        if scene.instances.is_empty() {
-            return self.resolve(ctx);
-        }
-        match self {
-            TraversalChoice::Hardware => Err(anyhow!(
-                "--traversal hardware: {}",
-                super::acceleration::INSTANCES_UNSUPPORTED
-            )),
-            TraversalChoice::Auto | TraversalChoice::Software => Ok(Traversal::Software),
-        }
-    }
-
     /// The traversal to run on `ctx`'s device.
     pub fn resolve(self, ctx: &GpuContext) -> Result<Traversal> {
         match self {

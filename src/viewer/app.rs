@@ -322,7 +322,7 @@ impl App {
         };
         surface.configure(&ctx.device, &config);
         let kernel_scene = self.kernel_scene();
-        let traversal = self.options.traversal.resolve_for(ctx, &kernel_scene)?;
+        let traversal = self.options.traversal.resolve(ctx)?;
         let renderer = GpuRenderer::with_traversal(ctx, &kernel_scene, traversal)?;
         let mut display = DisplayPass::new(&ctx.device, format);
         display.bind(&ctx.device, renderer.mean_buffer());
