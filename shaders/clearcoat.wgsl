@@ -57,6 +57,26 @@ fn clearcoat_lobe(weight: f32, alpha_in: f32, mu_o: f32) -> ClearcoatLobe {
     return l;
 }
 
+// The factor of a broad lobe below the coat that normalises the coat's scaling and the
+// lobe's own, 1 - L' = q0 + qa A + qb B, together (see clearcoat_coupling in the mirror):
+// (1 - c L_avg)(1 - L'_avg) / 2 int (1 - c L(mu))(1 - L'(mu)) mu dmu.
+fn clearcoat_coupling(l: ClearcoatLobe, alpha: f32, q0: vec3<f32>, qa: vec3<f32>, qb: vec3<f32>) -> vec3<f32> {
+    let p0 = 1.0 - l.weight * l.ms;
+    let pa = -l.weight * (CLEARCOAT_F0 - l.ms);
+    let pb = -l.weight * (1.0 - l.ms);
+    let coat_ab = ggx_albedo_average(l.alpha);
+    let layer_ab = ggx_albedo_average(alpha);
+    let m = ggx_albedo_product_average(l.alpha, alpha);
+    let coat_room = 1.0 - l.weight * l.albedo_average;
+    let layer_room = q0 + qa * layer_ab.x + qb * layer_ab.y;
+    let joint = p0 * layer_room
+        + q0 * (pa * coat_ab.x + pb * coat_ab.y)
+        + qa * (pa * m.x + pb * m.z)
+        + qb * (pa * m.y + pb * m.w);
+    let ratio = coat_room * layer_room / joint;
+    return select(vec3<f32>(1.0), ratio, joint > vec3<f32>(0.0));
+}
+
 // The share of light from wo that passes the coat (what refraction keeps).
 fn clearcoat_transmitted_o(l: ClearcoatLobe) -> f32 {
     return 1.0 - l.weight * l.albedo_o;

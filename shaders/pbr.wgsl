@@ -38,6 +38,10 @@ struct PbrLobes {
     coat_probability: f32,
     sheen_probability: f32,
     layers_o: f32,
+    // The factors of the diffuse base and of the multiple-scattering lobe that normalise the
+    // coat's scaling and their own together (clearcoat_coupling; 1 without a coat).
+    coat_diffuse_coupling: vec3<f32>,
+    coat_ms_coupling: f32,
 }
 
 fn channel_average(v: vec3<f32>) -> f32 {
@@ -104,6 +108,20 @@ fn pbr_lobes(m: Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> PbrLob
     if HAS_SHEEN && max(m.sheen_color.x, max(m.sheen_color.y, m.sheen_color.z)) > 0.0 {
         l.sheen = sheen_lobe(m.sheen_color, m.sheen_roughness, mu_o);
     }
+    l.coat_diffuse_coupling = vec3<f32>(1.0);
+    l.coat_ms_coupling = 1.0;
+    if HAS_CLEARCOAT && l.coat.weight > 0.0 {
+        // What passes the dielectric layer, 1 - Es = (1 - F_ms) - (f0 - F_ms) A - (f90 - F_ms) B,
+        // and what the multiple scattering leaves, 1 - E = 1 - A - B.
+        l.coat_diffuse_coupling = clearcoat_coupling(
+            l.coat,
+            l.alpha,
+            vec3<f32>(1.0) - l.ms_dielectric,
+            l.ms_dielectric - l.dielectric_f0,
+            l.ms_dielectric - vec3<f32>(l.dielectric_f90)
+        );
+        l.coat_ms_coupling = clearcoat_coupling(l.coat, l.alpha, vec3<f32>(1.0), vec3<f32>(-1.0), vec3<f32>(-1.0)).x;
+    }
     let below_coat = clearcoat_transmitted_o(l.coat);
     l.layers_o = below_coat * sheen_transmitted_o(l.sheen);
     l.coat_probability = 0.0;
@@ -158,13 +176,13 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>, coat_wo: vec3<f32>, coat_
     var out = vec3<f32>(0.0);
     if l.e_average < 1.0 {
         let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
-        out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
+        out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z * l.coat_ms_coupling);
     }
     let layer_i = l.dielectric_f0 * ab_i.x + vec3<f32>(l.dielectric_f90 * ab_i.y) + l.ms_dielectric * (1.0 - e_i);
     let transmitted = (vec3<f32>(1.0) - l.layer_o) * (vec3<f32>(1.0) - layer_i);
     let room = vec3<f32>(1.0) - l.layer_average;
     let base_weight = select(vec3<f32>(0.0), transmitted / room, room > vec3<f32>(0.0));
-    out += opaque * l.base * base_weight * (wi.z / PI);
+    out += opaque * l.base * base_weight * l.coat_diffuse_coupling * (wi.z / PI);
     if HAS_TRANSMISSION && transmissive > 0.0 {
         narrow += vec3<f32>(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }

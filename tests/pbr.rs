@@ -67,16 +67,52 @@ fn a_white_pbr_material_reflects_everything_at_every_angle() {
     }
 }
 
+/// The GGX albedo tables (src/ggx_energy.rs) read between their grid points, where every
+/// material's α falls, agree with the albedo integrated there directly on a grid 64 times
+/// finer: within 0.4% of the albedo, a small part of the furnaces' 1% (deterministic: no
+/// sampling noise). Worst measured: 0.3% for roughness 1 head-on (μ = 1 lies beyond the last
+/// column). With rows evenly spaced in α, a roughness-0.1 coat read between the rows at α
+/// 0.001 and 0.032 was 2% off at cos θ 0.05–0.1.
+#[test]
+fn the_ggx_tables_are_accurate_between_their_grid_points() {
+    use glint::cpu::ggx_energy::ggx_albedo;
+    use glint::ggx_energy::albedo_split_at_resolution;
+    let mut worst = 0.0f64;
+    for roughness in [0.0f32, 0.05, 0.1, 0.15, 0.2, 0.3, 0.45, 0.7, 1.0] {
+        let alpha = (roughness * roughness).max(1e-3);
+        for mu in [0.05f32, 0.1, 0.2, 0.35, 0.5, 0.8, 1.0] {
+            let (a, b) = ggx_albedo(mu, alpha);
+            let (exact_a, exact_b) = albedo_split_at_resolution(mu as f64, alpha as f64, 1024, 256);
+            // The coat's albedo weighs A by its f0 = 0.04, the white metal's E by 1.
+            for (name, read, exact) in [
+                ("A", a as f64, exact_a),
+                ("B", b as f64, exact_b),
+                ("E", (a + b) as f64, exact_a + exact_b),
+            ] {
+                worst = worst.max((read - exact).abs());
+                assert!(
+                    (read - exact).abs() < 0.004,
+                    "roughness {roughness}, cos θ {mu}: {name} read {read}, integrated {exact}"
+                );
+            }
+        }
+    }
+    eprintln!("GGX tables between grid points: worst error {worst:.5}");
+}
+
 /// KHR_materials_clearcoat's coat (f0 0.04, weight 1) over white stacks: the coat's
-/// reciprocal albedo scaling keeps the white furnace within 1% for coat roughness 0.5 and 1,
-/// plus 5 standard errors of the estimate (from the sample weights' variance). A smooth coat
-/// (roughness 0.1) misses by more, measured: up to +2.5% at cos θo 0.05 and −2.3% at 0.2 over
-/// half metal, +1.25% head-on over a smooth base (the product scaling of the broad lobes is
-/// exact only for a Lambertian base); its bound is 3%.
+/// reciprocal albedo scaling keeps the white furnace within 1% at every coat roughness (0 is
+/// the coat's smallest α, 10⁻³), plus 5 standard errors of the estimate (from the sample
+/// weights' variance). Measured before the GGX tables were spaced in roughness and the coat's
+/// and the base's scalings normalised together: up to 2.5% off for coat roughness 0.1.
+/// Except under a smooth coat over glossy metal: the metal's specular lobe is dimmed by
+/// min(1 − c L(μo), 1 − c L(μi)) (clearcoat.rs), which loses where the lobe spreads over
+/// angles at which the smooth coat's albedo changes fast: measured −2.8% at cos θo 0.2 over
+/// half metal of roughness 0.3, so 3% there.
 #[test]
 fn a_coat_over_a_white_pbr_stack_reflects_everything() {
     let mut worst = 0.0f64;
-    for coat_roughness in [0.1, 0.5, 1.0] {
+    for coat_roughness in [0.0, 0.1, 0.5, 1.0] {
         for (metallic, roughness) in [(0.0, 0.0), (0.0, 0.5), (0.0, 1.0), (0.5, 0.3)] {
             let m = Material {
                 clearcoat: 1.0,
@@ -86,7 +122,11 @@ fn a_coat_over_a_white_pbr_stack_reflects_everything() {
             for mu in [0.05, 0.2, 0.5, 0.8, 1.0] {
                 let (mean, error) = albedo(&m, mu, 40_000, 12);
                 worst = worst.max((mean - 1.0).abs());
-                let bound = if coat_roughness < 0.5 { 0.03 } else { 0.01 };
+                let bound = if coat_roughness < 0.5 && metallic > 0.0 {
+                    0.03
+                } else {
+                    0.01
+                };
                 if std::env::var("GLINT_PRINT_FURNACE").is_ok() {
                     eprintln!("coat {coat_roughness} metallic {metallic} roughness {roughness} mu {mu}: {mean:.4} ± {error:.4}");
                     continue;

@@ -1,14 +1,15 @@
 //! Lookups in the GGX albedo tables of `crate::ggx_energy` (WGSL side:
-//! `shaders/ggx_energy.wgsl`, which reads the same numbers from binding 24): bilinear in
-//! μ = cos θ and α, the same f32 operations on both sides.
+//! `shaders/ggx_energy.wgsl`, which reads the same numbers from binding 25): bilinear in
+//! μ = cos θ and roughness √α, the same f32 operations on both sides.
 
 use crate::ggx_energy::{
-    ggx_energy_table, GGX_ENERGY_SIZE, OFFSET_A, OFFSET_A_AVERAGE, OFFSET_B, OFFSET_B_AVERAGE,
+    ggx_energy_table, GGX_ENERGY_SIZE, OFFSET_A, OFFSET_AA_AVERAGE, OFFSET_AB_AVERAGE,
+    OFFSET_A_AVERAGE, OFFSET_B, OFFSET_BB_AVERAGE, OFFSET_B_AVERAGE,
 };
 
-/// The α row below `alpha` and the weight of the one above.
+/// The row below `alpha` and the weight of the one above: rows are evenly spaced in √α.
 fn alpha_row(alpha: f32) -> (usize, f32) {
-    let y = (alpha * (GGX_ENERGY_SIZE - 1) as f32).clamp(0.0, (GGX_ENERGY_SIZE - 1) as f32);
+    let y = (alpha.sqrt() * (GGX_ENERGY_SIZE - 1) as f32).clamp(0.0, (GGX_ENERGY_SIZE - 1) as f32);
     let j = (y as usize).min(GGX_ENERGY_SIZE - 2);
     (j, y - j as f32)
 }
@@ -41,4 +42,33 @@ pub fn ggx_albedo_average(alpha: f32) -> (f32, f32) {
         low + s * (table[offset + j + 1] - low)
     };
     (at(OFFSET_A_AVERAGE), at(OFFSET_B_AVERAGE))
+}
+
+/// The averages of products of the split-sum parts at two α, 2∫X(μ, α1) Y(μ, α2) μ dμ, for
+/// (X, Y) = (A, A), (A, B), (B, A), (B, B): bilinear in the two rows, which is exactly the
+/// average of the product of the interpolated rows.
+pub fn ggx_albedo_product_average(alpha1: f32, alpha2: f32) -> [f32; 4] {
+    let table = ggx_energy_table();
+    let n = GGX_ENERGY_SIZE;
+    let (j1, s1) = alpha_row(alpha1);
+    let (j2, s2) = alpha_row(alpha2);
+    // The part at `offset` with rows (k1, k2) = (j1, j2) + corner, bilinear in (s1, s2).
+    let at = |offset: usize, swapped: bool| {
+        let value = |k1: usize, k2: usize| {
+            if swapped {
+                table[offset + k2 * n + k1]
+            } else {
+                table[offset + k1 * n + k2]
+            }
+        };
+        let low = value(j1, j2) + s2 * (value(j1, j2 + 1) - value(j1, j2));
+        let high = value(j1 + 1, j2) + s2 * (value(j1 + 1, j2 + 1) - value(j1 + 1, j2));
+        low + s1 * (high - low)
+    };
+    [
+        at(OFFSET_AA_AVERAGE, false),
+        at(OFFSET_AB_AVERAGE, false),
+        at(OFFSET_AB_AVERAGE, true),
+        at(OFFSET_BB_AVERAGE, false),
+    ]
 }

@@ -38,7 +38,8 @@
 
 use super::bsdf::BsdfSample;
 use super::clearcoat::{
-    clearcoat_eval, clearcoat_lobe, clearcoat_transmitted_o, ClearcoatLobe, NO_CLEARCOAT,
+    clearcoat_coupling, clearcoat_eval, clearcoat_lobe, clearcoat_transmitted_o, ClearcoatLobe,
+    NO_CLEARCOAT,
 };
 use super::diffuse::sample_cosine_hemisphere;
 use super::frame::{from_local, to_local, PI};
@@ -95,6 +96,10 @@ pub struct PbrLobes {
     coat_probability: f32,
     sheen_probability: f32,
     layers_o: f32,
+    /// The factors of the diffuse base and of the multiple-scattering lobe that normalise the
+    /// coat's scaling and their own together (clearcoat_coupling; 1 without a coat).
+    coat_diffuse_coupling: Vec3,
+    coat_ms_coupling: f32,
 }
 
 fn average(v: Vec3) -> f32 {
@@ -189,6 +194,19 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> P
     } else {
         NO_SHEEN
     };
+    let (mut coat_diffuse_coupling, mut coat_ms_coupling) = (Vec3::ONE, 1.0);
+    if coat.weight > 0.0 {
+        // What passes the dielectric layer, 1 − Es = (1 − F_ms) − (f0 − F_ms) A − (f90 − F_ms) B,
+        // and what the multiple scattering leaves, 1 − E = 1 − A − B.
+        coat_diffuse_coupling = clearcoat_coupling(
+            &coat,
+            alpha,
+            Vec3::ONE - ms_dielectric,
+            ms_dielectric - dielectric_f0,
+            ms_dielectric - Vec3::splat(dielectric_f90),
+        );
+        coat_ms_coupling = clearcoat_coupling(&coat, alpha, Vec3::ONE, -Vec3::ONE, -Vec3::ONE).x;
+    }
     let below_coat = clearcoat_transmitted_o(&coat);
     let layers_o = below_coat * sheen_transmitted_o(&sheen);
     let (mut coat_probability, mut sheen_probability) = (0.0, 0.0);
@@ -231,6 +249,8 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> P
         coat_probability,
         sheen_probability,
         layers_o,
+        coat_diffuse_coupling,
+        coat_ms_coupling,
     }
 }
 
@@ -267,7 +287,10 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3, coat_wo: Vec3, coat_wi: Ve
     let mut out = Vec3::ZERO;
     if l.e_average < 1.0 {
         let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
-        out += ms * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average)) * wi.z);
+        out += ms
+            * ((1.0 - l.e_o) * (1.0 - e_i) / (PI * (1.0 - l.e_average))
+                * wi.z
+                * l.coat_ms_coupling);
     }
     let layer_i =
         l.dielectric_f0 * a_i + Vec3::splat(l.dielectric_f90 * b_i) + l.ms_dielectric * (1.0 - e_i);
@@ -290,7 +313,7 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3, coat_wo: Vec3, coat_wi: Ve
             0.0
         },
     );
-    out += opaque * l.base * base_weight * (wi.z / PI);
+    out += opaque * l.base * base_weight * l.coat_diffuse_coupling * (wi.z / PI);
     if transmissive > 0.0 {
         narrow += Vec3::splat(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }

@@ -263,8 +263,9 @@ pub fn path_step(
         &varied
     };
     // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
-    // else the unmapped one; the base's normal map does not reach it.
-    let mut coat_normal = hit.shading_normal;
+    // else the unmapped one; the base's normal map does not reach it. Normalised again as the
+    // kernel does (shaders/trace.wgsl says why).
+    let mut coat_normal = hit.shading_normal.normalize();
     if hit.primitive == PRIMITIVE_TRIANGLE {
         if m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
             coat_normal = normal_mapped(

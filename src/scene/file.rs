@@ -121,6 +121,9 @@ pub(super) struct MaterialToml {
     pub(super) clearcoat_roughness: Option<S<RoughnessToml>>,
     pub(super) sheen_color: Option<S<Triple>>,
     pub(super) sheen_roughness: Option<S<RoughnessToml>>,
+    /// The coat's own tangent-space normal map (glTF's clearcoatNormalTexture), in the forms
+    /// of `normal_map`.
+    pub(super) clearcoat_normal_map: Option<S<toml::Value>>,
     /// Any type, on meshes: `"opaque"` (the default), `"mask"` or `"blend"` (glTF's alphaMode),
     /// the constant `alpha` (which a colour texture's alpha multiplies) and the mask's
     /// `alpha_cutoff`.

@@ -231,12 +231,27 @@ pub(super) fn validate_materials(
                     }
                     None => (Vec3::ZERO, None),
                 };
+                // A coat's normal map without a coat would map nothing: most likely a mistake.
+                if let Some(n) = &m.clearcoat_normal_map {
+                    if clearcoat == 0.0 && clearcoat_texture.is_none() {
+                        return fail(
+                            n.span(),
+                            field("clearcoat_normal_map"),
+                            "the material has no coat to map: give it clearcoat > 0",
+                        );
+                    }
+                }
+                let clearcoat_normal_texture = m
+                    .clearcoat_normal_map
+                    .as_ref()
+                    .map(|n| normal_map(n, &field("clearcoat_normal_map"), folder, &mut textures))
+                    .transpose()?;
                 let layers = PbrLayers {
                     clearcoat,
                     clearcoat_roughness,
                     clearcoat_texture,
                     clearcoat_roughness_texture,
-                    clearcoat_normal_texture: None,
+                    clearcoat_normal_texture,
                     sheen_color,
                     sheen_roughness,
                     sheen_color_texture,
@@ -313,6 +328,11 @@ pub(super) fn validate_materials(
             (
                 m.clearcoat_roughness.as_ref().map(|r| r.span()),
                 "clearcoat_roughness",
+                pbr,
+            ),
+            (
+                m.clearcoat_normal_map.as_ref().map(|r| r.span()),
+                "clearcoat_normal_map",
                 pbr,
             ),
             (m.sheen_color.as_ref().map(|r| r.span()), "sheen_color", pbr),
@@ -494,9 +514,6 @@ fn alpha(m: &MaterialToml, field: &dyn Fn(&str) -> String) -> Result<Alpha, Fiel
     Ok(Alpha { mode, opacity })
 }
 
-/// `normal_map = "file.png"` or `{ file = "file.png", scale = s }` (relative to `folder`;
-/// `scale` finite, default 1): a tangent-space normal map read as glTF's normalTexture
-/// (linear, x and y times the scale). Returns its index in `textures` and the scale.
 /// A texture table's optional `scale` (1 when absent), an integer or a float.
 fn table_scale(x: &S<toml::Value>, table: &toml::Table, field: &str) -> Result<f64, FieldError> {
     match table.get("scale") {
@@ -511,6 +528,10 @@ fn table_scale(x: &S<toml::Value>, table: &toml::Table, field: &str) -> Result<f
     }
 }
 
+/// `normal_map = "file.png"` or `{ file = "file.png", scale = s }` (relative to `folder`;
+/// `scale` finite, default 1): a tangent-space normal map read as glTF's normalTexture
+/// (linear, x and y times the scale); the coat's `clearcoat_normal_map` too. Returns its
+/// index in `textures` and the scale.
 fn normal_map(
     x: &S<toml::Value>,
     field: &str,
