@@ -77,8 +77,11 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     // else the unmapped one; the base's normal map does not reach it. Normalised again (the
     // same vector but for rounding) so that no kernel variant can prove it the base's and
     // merge the coat's arithmetic with the base's: every variant rounds the coat alike
-    // (tests/scene_binding.rs).
-    var coat_normal = normalize(hit.shading_normal);
+    // (tests/scene_binding.rs). Only where a coat is compiled in: nothing else reads it.
+    var coat_normal = hit.shading_normal;
+    if HAS_CLEARCOAT {
+        coat_normal = normalize(coat_normal);
+    }
     if HAS_TEXTURES && hit.primitive == PRIMITIVE_TRIANGLE {
         if HAS_CLEARCOAT && m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
             coat_normal = normal_mapped(hit, m.clearcoat_normal_texture, m.clearcoat_normal_scale, -ray.dir);

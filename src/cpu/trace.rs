@@ -264,8 +264,11 @@ pub fn path_step(
     };
     // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
     // else the unmapped one; the base's normal map does not reach it. Normalised again as the
-    // kernel does (shaders/trace.wgsl says why).
-    let mut coat_normal = hit.shading_normal.normalize();
+    // kernel does (shaders/trace.wgsl says why), where there is a coat: nothing else reads it.
+    let mut coat_normal = hit.shading_normal;
+    if m.clearcoat > 0.0 {
+        coat_normal = coat_normal.normalize();
+    }
     if hit.primitive == PRIMITIVE_TRIANGLE {
         if m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
             coat_normal = normal_mapped(
