@@ -1176,3 +1176,41 @@ fn gltf_reuse_with_a_zero_scale_node_is_copied() {
     assert!(scene.instanced.is_empty());
     assert_eq!(scene.triangles.len(), 2 * mesh.indices.len());
 }
+
+// --- What `render --json` says of an instanced scene ---
+
+/// `--json` tells stored from placed triangles: an instanced mesh's triangles once in
+/// `triangles`, once per instance in `placed_triangles`, with the instance count.
+#[test]
+fn render_json_counts_stored_and_placed_triangles() {
+    let dir = tempfile::tempdir().unwrap();
+    let list = PLACEMENTS.map(|p| format!("{{ {p} }}")).join(", ");
+    let toml = format!(
+        "{MESH_SCENE_HEADER}\n[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\ninstances = [{list}]\n"
+    );
+    load(dir.path(), &toml).unwrap_or_else(|e| panic!("{e}"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args([
+            "render",
+            "scene.toml",
+            "--cpu",
+            "--width",
+            "8",
+            "--height",
+            "8",
+        ])
+        .args(["--spp", "1", "-o", "out.png", "--json"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let per_mesh = StressMesh::new(24, 12).indices.len() as u64;
+    assert_eq!(summary["triangles"], per_mesh);
+    assert_eq!(summary["instances"], 4);
+    assert_eq!(summary["placed_triangles"], 4 * per_mesh);
+}

@@ -327,7 +327,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
             "backend": renderer.backend_name(),
             // The GPU's traversal; the CPU reference's is its BVH ("software").
             "traversal": traversal.unwrap_or(crate::gpu::Traversal::Software).name(),
+            // Stored (an instanced mesh once), then placed (once per instance).
             "triangles": kernel_scene.triangles.len(),
+            "instances": kernel_scene.instances.len(),
+            "placed_triangles": scene.placed_triangle_count(),
             "bvh_nodes": kernel_scene.bvh_nodes.len(),
             "bvh_build_seconds": kernel_scene.bvh_build_seconds,
             "scene_bytes": kernel_scene.scene_bytes(),
