@@ -107,13 +107,23 @@ fn the_ggx_tables_are_accurate_between_their_grid_points() {
 /// and the base's scalings normalised together: up to 2.5% off for coat roughness 0.1.
 /// Except under a smooth coat over glossy metal: the metal's specular lobe is dimmed by
 /// min(1 − c L(μo), 1 − c L(μi)) (clearcoat.rs), which loses where the lobe spreads over
-/// angles at which the smooth coat's albedo changes fast: measured −2.8% at cos θo 0.2 over
-/// half metal of roughness 0.3, so 3% there.
+/// angles at which the smooth coat's albedo changes fast: measured up to −4.3% over full
+/// metal of roughness 0.5 under a coat of roughness 0 or 0.1 (−2.9% over half metal of
+/// roughness 0.3, −2.8% over metal of roughness 1), and −1.35% under a coat of roughness 0.5;
+/// so 5% and 2% there. Smooth metal (a mirror, where the min is exact) keeps 1%.
 #[test]
 fn a_coat_over_a_white_pbr_stack_reflects_everything() {
     let mut worst = 0.0f64;
     for coat_roughness in [0.0, 0.1, 0.5, 1.0] {
-        for (metallic, roughness) in [(0.0, 0.0), (0.0, 0.5), (0.0, 1.0), (0.5, 0.3)] {
+        for (metallic, roughness) in [
+            (0.0, 0.0),
+            (0.0, 0.5),
+            (0.0, 1.0),
+            (0.5, 0.3),
+            (1.0, 0.0),
+            (1.0, 0.5),
+            (1.0, 1.0),
+        ] {
             let m = Material {
                 clearcoat: 1.0,
                 clearcoat_alpha: coat_roughness * coat_roughness,
@@ -122,8 +132,11 @@ fn a_coat_over_a_white_pbr_stack_reflects_everything() {
             for mu in [0.05, 0.2, 0.5, 0.8, 1.0] {
                 let (mean, error) = albedo(&m, mu, 40_000, 12);
                 worst = worst.max((mean - 1.0).abs());
-                let bound = if coat_roughness < 0.5 && metallic > 0.0 {
-                    0.03
+                // Glossy metal under a smooth or medium coat: see above.
+                let bound = if metallic > 0.0 && roughness > 0.0 && coat_roughness < 0.5 {
+                    0.05
+                } else if metallic > 0.0 && roughness > 0.0 && coat_roughness < 1.0 {
+                    0.02
                 } else {
                     0.01
                 };
@@ -314,7 +327,15 @@ fn a_coat_over_a_black_base_reflects_the_coats_share() {
 fn a_white_sheen_over_a_white_pbr_stack_loses_at_most_what_its_scaling_takes() {
     let mut worst = 0.0f64;
     for sheen_roughness in [0.3, 0.6, 1.0] {
-        for (metallic, roughness) in [(0.0, 0.0), (0.0, 0.5), (0.0, 1.0), (0.5, 0.3)] {
+        for (metallic, roughness) in [
+            (0.0, 0.0),
+            (0.0, 0.5),
+            (0.0, 1.0),
+            (0.5, 0.3),
+            (1.0, 0.0),
+            (1.0, 0.5),
+            (1.0, 1.0),
+        ] {
             let m = Material {
                 sheen_color: [1.0; 3],
                 sheen_roughness,

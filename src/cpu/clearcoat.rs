@@ -16,7 +16,7 @@
 //!   tests/pbr.rs's furnace). The base's diffuse and multiple-scattering lobes, which their
 //!   own layer scales the same way, are normalised with the coat's scaling together
 //!   ([`clearcoat_coupling`]). So a coat over a white stack keeps nearly all the energy
-//!   (within 1% at every coat roughness, but up to 3% lost under a smooth coat over glossy
+//!   (within 1% at every coat roughness, but up to 4.3% lost under a smooth coat over glossy
 //!   metal: README.md), which F_coat's scaling does not (it cannot see the light the coat's
 //!   rough lobe misses).
 //!
