@@ -100,6 +100,18 @@ fn the_ggx_tables_are_accurate_between_their_grid_points() {
     eprintln!("GGX tables between grid points: worst error {worst:.5}");
 }
 
+/// The white stacks the coat's and the sheen's furnaces lie over, as (metallic, roughness):
+/// dielectric and metal at roughness 0, 0.5 and 1, and half metal at 0.3.
+const WHITE_STACKS: [(f32, f32); 7] = [
+    (0.0, 0.0),
+    (0.0, 0.5),
+    (0.0, 1.0),
+    (0.5, 0.3),
+    (1.0, 0.0),
+    (1.0, 0.5),
+    (1.0, 1.0),
+];
+
 /// KHR_materials_clearcoat's coat (f0 0.04, weight 1) over white stacks: the coat's
 /// reciprocal albedo scaling keeps the white furnace within 1% at every coat roughness (0 is
 /// the coat's smallest α, 10⁻³), plus 5 standard errors of the estimate (from the sample
@@ -115,15 +127,7 @@ fn the_ggx_tables_are_accurate_between_their_grid_points() {
 fn a_coat_over_a_white_pbr_stack_reflects_everything() {
     let mut worst = 0.0f64;
     for coat_roughness in [0.0, 0.1, 0.5, 1.0] {
-        for (metallic, roughness) in [
-            (0.0, 0.0),
-            (0.0, 0.5),
-            (0.0, 1.0),
-            (0.5, 0.3),
-            (1.0, 0.0),
-            (1.0, 0.5),
-            (1.0, 1.0),
-        ] {
+        for (metallic, roughness) in WHITE_STACKS {
             let m = Material {
                 clearcoat: 1.0,
                 clearcoat_alpha: coat_roughness * coat_roughness,
@@ -327,15 +331,7 @@ fn a_coat_over_a_black_base_reflects_the_coats_share() {
 fn a_white_sheen_over_a_white_pbr_stack_loses_at_most_what_its_scaling_takes() {
     let mut worst = 0.0f64;
     for sheen_roughness in [0.3, 0.6, 1.0] {
-        for (metallic, roughness) in [
-            (0.0, 0.0),
-            (0.0, 0.5),
-            (0.0, 1.0),
-            (0.5, 0.3),
-            (1.0, 0.0),
-            (1.0, 0.5),
-            (1.0, 1.0),
-        ] {
+        for (metallic, roughness) in WHITE_STACKS {
             let m = Material {
                 sheen_color: [1.0; 3],
                 sheen_roughness,
