@@ -202,6 +202,41 @@ enum BlasInput<'a> {
     Boxes(&'a [[f32; 6]]),
 }
 
+/// One BLAS's geometry size, which its creation and its build both take.
+enum BlasSize {
+    Triangles(wgpu::BlasTriangleGeometrySizeDescriptor),
+    Boxes(wgpu::BlasAABBGeometrySizeDescriptor),
+}
+
+impl BlasInput<'_> {
+    fn size(&self) -> BlasSize {
+        let flags = wgpu::AccelerationStructureGeometryFlags::OPAQUE;
+        match self {
+            BlasInput::Triangles(vertices) => {
+                BlasSize::Triangles(wgpu::BlasTriangleGeometrySizeDescriptor {
+                    vertex_format: wgpu::VertexFormat::Float32x3,
+                    vertex_count: vertices.len() as u32,
+                    index_format: None,
+                    index_count: None,
+                    flags,
+                })
+            }
+            BlasInput::Boxes(boxes) => BlasSize::Boxes(wgpu::BlasAABBGeometrySizeDescriptor {
+                primitive_count: boxes.len() as u32,
+                flags,
+            }),
+        }
+    }
+
+    /// Its buffer's label and contents.
+    fn contents(&self) -> (&'static str, &[u8]) {
+        match self {
+            BlasInput::Triangles(vertices) => ("BLAS vertices", bytemuck::cast_slice(vertices)),
+            BlasInput::Boxes(boxes) => ("BLAS boxes", bytemuck::cast_slice(boxes)),
+        }
+    }
+}
+
 /// Builds `scene`'s acceleration structure on `ctx`'s device, which must have ray queries.
 /// A scene over the device's limits is an error naming the limit.
 pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStructure> {
@@ -293,64 +328,32 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
         flags,
         update_mode: wgpu::AccelerationStructureUpdateMode::Build,
     };
-    let input_buffer = |label: &str, contents: &[u8]| {
-        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents,
-            usage: wgpu::BufferUsages::BLAS_INPUT,
+    let sizes: Vec<BlasSize> = blas_inputs.iter().map(|(input, _)| input.size()).collect();
+    let blases: Vec<wgpu::Blas> = sizes
+        .iter()
+        .map(|size| {
+            let descriptors = match size {
+                BlasSize::Triangles(s) => wgpu::BlasGeometrySizeDescriptors::Triangles {
+                    descriptors: vec![s.clone()],
+                },
+                BlasSize::Boxes(s) => wgpu::BlasGeometrySizeDescriptors::AABBs {
+                    descriptors: vec![s.clone()],
+                },
+            };
+            device.create_blas(&blas_descriptor, descriptors)
         })
-    };
-    let opaque = wgpu::AccelerationStructureGeometryFlags::OPAQUE;
-    let mut triangle_sizes = Vec::new();
-    let mut box_sizes = Vec::new();
-    for (input, _) in &blas_inputs {
-        match input {
-            BlasInput::Triangles(vertices) => {
-                triangle_sizes.push(wgpu::BlasTriangleGeometrySizeDescriptor {
-                    vertex_format: wgpu::VertexFormat::Float32x3,
-                    vertex_count: vertices.len() as u32,
-                    index_format: None,
-                    index_count: None,
-                    flags: opaque,
-                })
-            }
-            BlasInput::Boxes(boxes) => box_sizes.push(wgpu::BlasAABBGeometrySizeDescriptor {
-                primitive_count: boxes.len() as u32,
-                flags: opaque,
-            }),
-        }
-    }
-    let mut blases = Vec::new();
-    let mut inputs = Vec::new();
-    let (mut next_triangles, mut next_boxes) = (0, 0);
-    // Which size descriptor each BLAS has.
-    let mut size_of_blas = Vec::new();
-    for (input, _) in &blas_inputs {
-        let (sizes, buffer) = match input {
-            BlasInput::Triangles(vertices) => {
-                size_of_blas.push(next_triangles);
-                next_triangles += 1;
-                (
-                    wgpu::BlasGeometrySizeDescriptors::Triangles {
-                        descriptors: vec![triangle_sizes[next_triangles - 1].clone()],
-                    },
-                    input_buffer("BLAS vertices", bytemuck::cast_slice(vertices)),
-                )
-            }
-            BlasInput::Boxes(boxes) => {
-                size_of_blas.push(next_boxes);
-                next_boxes += 1;
-                (
-                    wgpu::BlasGeometrySizeDescriptors::AABBs {
-                        descriptors: vec![box_sizes[next_boxes - 1].clone()],
-                    },
-                    input_buffer("BLAS boxes", bytemuck::cast_slice(boxes)),
-                )
-            }
-        };
-        blases.push(device.create_blas(&blas_descriptor, sizes));
-        inputs.push(buffer);
-    }
+        .collect();
+    let inputs: Vec<wgpu::Buffer> = blas_inputs
+        .iter()
+        .map(|(input, _)| {
+            let (label, contents) = input.contents();
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::BLAS_INPUT,
+            })
+        })
+        .collect();
     let mut tlas = device.create_tlas(&wgpu::CreateTlasDescriptor {
         label: Some("glint TLAS"),
         max_instances: tlas_instances.len() as u32,
@@ -365,15 +368,15 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
             0xff,
         ));
     }
-    let entries: Vec<_> = blas_inputs
+    let entries: Vec<_> = sizes
         .iter()
         .enumerate()
-        .map(|(i, (input, _))| wgpu::BlasBuildEntry {
+        .map(|(i, size)| wgpu::BlasBuildEntry {
             blas: &blases[i],
-            geometry: match input {
-                BlasInput::Triangles(_) => {
+            geometry: match size {
+                BlasSize::Triangles(size) => {
                     wgpu::BlasGeometries::TriangleGeometries(vec![wgpu::BlasTriangleGeometry {
-                        size: &triangle_sizes[size_of_blas[i]],
+                        size,
                         vertex_buffer: &inputs[i],
                         first_vertex: 0,
                         vertex_stride: size_of::<[f32; 3]>() as u64,
@@ -383,9 +386,9 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
                         transform_buffer_offset: None,
                     }])
                 }
-                BlasInput::Boxes(_) => {
+                BlasSize::Boxes(size) => {
                     wgpu::BlasGeometries::AabbGeometries(vec![wgpu::BlasAabbGeometry {
-                        size: &box_sizes[size_of_blas[i]],
+                        size,
                         stride: size_of::<[f32; 6]>() as u64,
                         aabb_buffer: &inputs[i],
                         primitive_offset: 0,
