@@ -11,7 +11,7 @@
 
 mod common;
 use common::probe::{run_probe_bvh, ProbeParams};
-use common::{gpu, render_cpu, render_gpu, PathAgreement, MESH_SCENE_HEADER};
+use common::{gpu, render_cpu, render_gpu, MESH_SCENE_HEADER};
 use glam::{Mat4, Vec3};
 use glint::cpu::instance::transform_point;
 use glint::cpu::intersect::{
@@ -120,12 +120,11 @@ fn instances_are_the_flattened_meshes_on_the_cpu() {
     let (instanced, flattened) = instanced_and_flattened(dir.path(), "white");
     let (instanced_kernel, flattened_kernel) = (lit(instanced.clone()), lit(flattened.clone()));
     assert!(!instanced_kernel.instances.is_empty() && flattened_kernel.instances.is_empty());
-    let mut agreement = PathAgreement::default();
-    agreement.add(
+    common::assert_paths_agree(
         &render_cpu(&flattened_kernel, 1),
         &render_cpu(&instanced_kernel, 1),
+        0.99,
     );
-    agreement.check(0.99);
     use glint::compare::compare;
     use glint::render::Renderer;
     let render = |scene: &KernelScene| {
@@ -167,12 +166,8 @@ fn instances_are_the_flattened_meshes_on_the_gpu() {
     let (instanced, flattened) = instanced_and_flattened(dir.path(), "white");
     let (instanced, flattened) = (lit(instanced), lit(flattened));
     let image = render_gpu(ctx, &instanced, 1);
-    let mut flat = PathAgreement::default();
-    flat.add(&render_gpu(ctx, &flattened, 1), &image);
-    flat.check(0.99);
-    let mut agreement = PathAgreement::default();
-    agreement.add(&render_cpu(&instanced, 1), &image);
-    agreement.check(0.99);
+    common::assert_paths_agree(&render_gpu(ctx, &flattened, 1), &image, 0.99);
+    common::assert_paths_agree(&render_cpu(&instanced, 1), &image, 0.99);
 }
 
 /// Emitting instances are flattened, as before: emitters like the flattened meshes'
@@ -719,12 +714,8 @@ fn hardware_traversal_traces_instances() {
         render_image(&mut renderer, 1, 1).unwrap()
     };
     let image = hardware(&scene);
-    let mut software = PathAgreement::default();
-    software.add(&render_gpu(ctx, &scene, 1), &image);
-    software.check(0.99);
-    let mut cpu = PathAgreement::default();
-    cpu.add(&render_cpu(&scene, 1), &image);
-    cpu.check(0.99);
+    common::assert_paths_agree(&render_gpu(ctx, &scene, 1), &image, 0.99);
+    common::assert_paths_agree(&render_cpu(&scene, 1), &image, 0.99);
     let coincident = |list: &str| {
         let text = format!(
             "{MESH_SCENE_HEADER}\n[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\ninstances = [{list}]\n"
@@ -1048,9 +1039,7 @@ fn gltf_reused_meshes_are_the_flattened_meshes_on_the_cpu() {
     for reuse in [Reuse::Nodes, Reuse::GpuInstancing] {
         let instanced = scene(reuse);
         assert_eq!(instanced.instances.len(), 3);
-        let mut agreement = PathAgreement::default();
-        agreement.add(&flat, &render_cpu(&instanced, 1));
-        agreement.check(0.99);
+        common::assert_paths_agree(&flat, &render_cpu(&instanced, 1), 0.99);
     }
 }
 
@@ -1074,12 +1063,8 @@ fn gltf_reused_meshes_are_the_flattened_meshes_on_the_gpu() {
         let instanced = scene(reuse);
         assert_eq!(instanced.instances.len(), 3);
         let image = render_gpu(ctx, &instanced, 1);
-        let mut agreement = PathAgreement::default();
-        agreement.add(&flat, &image);
-        agreement.check(0.99);
-        let mut agreement = PathAgreement::default();
-        agreement.add(&render_cpu(&instanced, 1), &image);
-        agreement.check(0.99);
+        common::assert_paths_agree(&flat, &image, 0.99);
+        common::assert_paths_agree(&render_cpu(&instanced, 1), &image, 0.99);
     }
 }
 
@@ -1189,20 +1174,12 @@ fn render_json_counts_stored_and_placed_triangles() {
         "{MESH_SCENE_HEADER}\n[[meshes]]\nfile = \"mesh.ply\"\nmaterial = \"white\"\ninstances = [{list}]\n"
     );
     load(dir.path(), &toml).unwrap_or_else(|e| panic!("{e}"));
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
-        .args([
-            "render",
-            "scene.toml",
-            "--cpu",
-            "--width",
-            "8",
-            "--height",
-            "8",
-        ])
-        .args(["--spp", "1", "-o", "out.png", "--json"])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
+    let out = common::run_render_with(
+        "--cpu",
+        &dir.path().join("scene.toml"),
+        &dir.path().join("out.png"),
+        &["--width", "8", "--height", "8", "--spp", "1", "--json"],
+    );
     assert!(
         out.status.success(),
         "{}",

@@ -186,6 +186,14 @@ material = "lamp"
     ))
 }
 
+/// Asserts that at least `min_fraction` of the paths of two renders at 1 spp agree
+/// ([`PathAgreement`], one pair).
+pub fn assert_paths_agree(cpu: &Image, gpu: &Image, min_fraction: f64) {
+    let mut agreement = PathAgreement::default();
+    agreement.add(cpu, gpu);
+    agreement.check(min_fraction);
+}
+
 /// Pixel-by-pixel agreement of a CPU and a GPU render at 1 spp, where each pixel is one path
 /// (see tests/gpu_vs_cpu.rs for why a small fraction may differ).
 #[derive(Default)]
@@ -233,11 +241,22 @@ impl PathAgreement {
 
 /// `glint render DEVICE SCENE -o OUT` (DEVICE is `--cpu` or `--gpu`), run to its end.
 pub fn run_render(device: &str, scene: &Path, out: &Path) -> std::process::Output {
+    run_render_with(device, scene, out, &[])
+}
+
+/// [`run_render`] with more arguments after the rest.
+pub fn run_render_with(
+    device: &str,
+    scene: &Path,
+    out: &Path,
+    more: &[&str],
+) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
         .args(["render", device])
         .arg(scene)
         .arg("-o")
         .arg(out)
+        .args(more)
         .output()
         .expect("run glint")
 }
