@@ -61,8 +61,6 @@ pub struct SceneRefs<'a> {
     pub environment_alias: &'a [EnvironmentAlias],
     /// Point, spot and directional lights (`punctual.rs`).
     pub lights: &'a [Light],
-    /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
-    pub has_alpha: bool,
     /// What intersection reads: the arrays above, and the key of the ray segment being traced
     /// (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`. Built once
     /// here, not per ray: building it for every ray and shadow ray was 3% of a CPU render.
@@ -96,11 +94,15 @@ impl<'a> SceneRefs<'a> {
             triangle_tangents: &scene.triangle_tangents,
             triangle_colors: &scene.triangle_colors,
             lights: &scene.lights,
-            has_alpha: has_alpha(&scene.materials),
             geometry: Geometry::default(),
         };
         refs.geometry = refs.build_geometry();
         refs
+    }
+
+    /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
+    pub fn has_alpha(&self) -> bool {
+        self.geometry.alpha.enabled
     }
 
     /// What texture lookups read.
@@ -137,7 +139,7 @@ impl<'a> SceneRefs<'a> {
             triangle_uvs1: self.triangle_uvs1,
             textured: !self.textures.is_empty(),
             alpha: AlphaTest {
-                enabled: self.has_alpha,
+                enabled: has_alpha(self.materials),
                 materials: self.materials,
                 textures: self.textures(),
                 triangle_uvs: self.triangle_uvs,
@@ -208,7 +210,7 @@ pub fn path_step(
     // This segment's alpha decisions (alpha.rs): segment `bounce`, the one the ray leaving the
     // previous vertex (or the camera) opened. A copy only where alpha is read at all.
     let keyed;
-    let scene = if scene.has_alpha {
+    let scene = if scene.has_alpha() {
         keyed = scene.with_alpha_key(alpha_segment_key(params, pixel, sample, bounce));
         &keyed
     } else {
@@ -345,7 +347,7 @@ pub fn path_step(
                 // The shadow ray leaves this vertex as the next bounce's ray will: the same
                 // segment's key, so both see the same blended triangles.
                 let keyed;
-                let shadow_scene = if scene.has_alpha {
+                let shadow_scene = if scene.has_alpha() {
                     let key = alpha_segment_key(params, pixel, sample, bounce + 1);
                     keyed = scene.with_alpha_key(key);
                     &keyed
