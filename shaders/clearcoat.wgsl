@@ -2,7 +2,8 @@
 // dielectric layer (f0 = 0.04, f90 = 1) with Kulla and Conty's multiple scattering, weighted
 // by the clearcoat factor c, over the whole pbr stack; the stack is scaled by the coat's whole
 // albedo L, reciprocally: its broad lobes by (1 - c L(mu_o)) (1 - c L(mu_i)) / (1 - c L_avg),
-// its specular lobes by min(1 - c L(mu_o), 1 - c L(mu_i)).
+// its specular lobes by 1 - c min(1, max(L(mu_o), L(mu_i)) h(mu_o) h(mu_i)), h from
+// src/clearcoat_energy.rs for each part of their Schlick Fresnel.
 // Compiled in only when a material has a coat (HAS_CLEARCOAT, src/shader.rs).
 
 // The coat's Fresnel at normal incidence: ior 1.5.
@@ -22,17 +23,23 @@ struct ClearcoatLobe {
     // c times the single- and the multiple-scattering albedo at mu_o, for sampling.
     specular_albedo_o: f32,
     ms_albedo_o: f32,
+    // The alpha of the specular lobes below, and the factors (h_A, h_B)(mu_o) of their
+    // scaling (src/clearcoat_energy.rs).
+    base_alpha: f32,
+    narrow_scale_o: vec2<f32>,
 }
 
 // The coat's own f cos(theta_i), and the scales of the broad and the specular lobes below.
 struct ClearcoatEval {
     f_cos: f32,
     below_broad: f32,
-    below_narrow: f32,
+    // For the two parts of a specular lobe, weighted by 1 - (1 - cos(theta_h))^5 and by
+    // (1 - cos(theta_h))^5 (Schlick's f0 and f90 terms).
+    below_narrow: vec2<f32>,
 }
 
 fn no_clearcoat() -> ClearcoatLobe {
-    return ClearcoatLobe(0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    return ClearcoatLobe(0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, vec2<f32>(1.0));
 }
 
 // The coat's whole albedo L from its split-sum parts.
@@ -40,7 +47,8 @@ fn clearcoat_layer_albedo(a: f32, b: f32, e: f32, ms: f32) -> f32 {
     return CLEARCOAT_F0 * a + b + ms * (1.0 - e);
 }
 
-fn clearcoat_lobe(weight: f32, alpha_in: f32, mu_o: f32) -> ClearcoatLobe {
+// The coat of weight c and alpha over specular lobes of alpha base_alpha, seen from mu_o.
+fn clearcoat_lobe(weight: f32, alpha_in: f32, mu_o: f32, base_alpha: f32) -> ClearcoatLobe {
     var l: ClearcoatLobe;
     l.weight = weight;
     l.alpha = max(alpha_in, CLEARCOAT_MIN_ALPHA);
@@ -54,6 +62,8 @@ fn clearcoat_lobe(weight: f32, alpha_in: f32, mu_o: f32) -> ClearcoatLobe {
     l.albedo_average = clearcoat_layer_albedo(ab_average.x, ab_average.y, l.e_average, l.ms);
     l.specular_albedo_o = weight * (CLEARCOAT_F0 * ab_o.x + ab_o.y);
     l.ms_albedo_o = weight * l.ms * (1.0 - l.e_o);
+    l.base_alpha = base_alpha;
+    l.narrow_scale_o = clearcoat_narrow_scale(mu_o, base_alpha, l.alpha);
     return l;
 }
 
@@ -95,7 +105,9 @@ fn clearcoat_eval(l: ClearcoatLobe, wo: vec3<f32>, wi: vec3<f32>) -> ClearcoatEv
     if room > 0.0 {
         below_broad = passed / room;
     }
-    let below_narrow = min(1.0 - l.weight * l.albedo_o, 1.0 - l.weight * albedo_i);
+    let narrow_scale_i = clearcoat_narrow_scale(abs(wi.z), l.base_alpha, l.alpha);
+    let larger = max(l.albedo_o, albedo_i) * l.narrow_scale_o * narrow_scale_i;
+    let below_narrow = vec2<f32>(1.0) - l.weight * min(larger, vec2<f32>(1.0));
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return ClearcoatEval(0.0, below_broad, below_narrow);
     }

@@ -102,7 +102,7 @@ fn pbr_lobes(m: Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> PbrLob
     // against the stack's (which they dim), each within [0.1, 0.45] when present.
     l.coat = no_clearcoat();
     if HAS_CLEARCOAT && m.clearcoat > 0.0 {
-        l.coat = clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, coat_mu_o);
+        l.coat = clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, coat_mu_o, l.alpha);
     }
     l.sheen = no_sheen();
     if HAS_SHEEN && max(m.sheen_color.x, max(m.sheen_color.y, m.sheen_color.z)) > 0.0 {
@@ -164,15 +164,14 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>, coat_wo: vec3<f32>, coat_
     let h = normalize(wo + wi);
     let c = clamp(1.0 - dot(wo, h), 0.0, 1.0);
     let s5 = c * c * c * c * c;
-    let f_dielectric = l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * s5;
-    let f_metal = l.base + (vec3<f32>(1.0) - l.base) * s5;
-    let fresnel = opaque * f_dielectric + l.metallic * f_metal;
     let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
-    let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
+    let dg = ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z);
+    // The specular lobes apart from the broad ones: the coat scales them as narrow lobes, the
+    // two parts of Schlick's Fresnel f0 (1 - s^5) + f90 s^5 each by its own factor.
+    var narrow_f0 = (opaque * l.dielectric_f0 + l.metallic * l.base) * ((1.0 - s5) * dg);
+    var narrow_f90 = vec3<f32>((opaque * l.dielectric_f90 + l.metallic) * s5 * dg);
     let ab_i = ggx_albedo(wi.z, l.alpha);
     let e_i = ab_i.x + ab_i.y;
-    // The specular lobes apart from the broad ones: the coat scales them as narrow lobes.
-    var narrow = specular;
     var out = vec3<f32>(0.0);
     if l.e_average < 1.0 {
         let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
@@ -184,18 +183,21 @@ fn pbr_eval(l: PbrLobes, wo: vec3<f32>, wi: vec3<f32>, coat_wo: vec3<f32>, coat_
     let base_weight = select(vec3<f32>(0.0), transmitted / room, room > vec3<f32>(0.0));
     out += opaque * l.base * base_weight * l.coat_diffuse_coupling * (wi.z / PI);
     if HAS_TRANSMISSION && transmissive > 0.0 {
-        narrow += vec3<f32>(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+        // Its exact Fresnel is f90-like: small head-on, all of the reflection at grazing.
+        narrow_f90 += vec3<f32>(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }
     if HAS_SHEEN && max(l.sheen.color.x, max(l.sheen.color.y, l.sheen.color.z)) > 0.0 {
         let sheen = sheen_eval(l.sheen, wo, wi);
         out = sheen.f_cos + sheen.below * out;
-        narrow *= sheen.below;
+        narrow_f0 *= sheen.below;
+        narrow_f90 *= sheen.below;
     }
     if HAS_CLEARCOAT && l.coat.weight > 0.0 {
         let coat = clearcoat_eval(l.coat, coat_wo, coat_wi);
-        return vec3<f32>(coat.f_cos) + coat.below_broad * out + coat.below_narrow * narrow;
+        return vec3<f32>(coat.f_cos) + coat.below_broad * out + coat.below_narrow.x * narrow_f0
+            + coat.below_narrow.y * narrow_f90;
     }
-    return out + narrow;
+    return out + narrow_f0 + narrow_f90;
 }
 
 // The mixture pdf of pbr_sample; wo and wi in the base's local frame, coat_wo and coat_wi in

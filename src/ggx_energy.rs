@@ -178,13 +178,13 @@ fn normalize(v: [f64; 3]) -> [f64; 3] {
 }
 
 /// Smith's Λ for GGX.
-fn lambda(w: [f64; 3], alpha: f64) -> f64 {
+pub(crate) fn lambda(w: [f64; 3], alpha: f64) -> f64 {
     let x = alpha * alpha * (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2]).max(1e-300);
     x / (2.0 * (1.0 + (1.0 + x).sqrt()))
 }
 
 /// Heitz's sampling of visible normals (JCGT 2018), as in `src/cpu/microfacet.rs`.
-fn visible_normal(wo: [f64; 3], alpha: f64, u: (f64, f64)) -> [f64; 3] {
+pub(crate) fn visible_normal(wo: [f64; 3], alpha: f64, u: (f64, f64)) -> [f64; 3] {
     let vh = normalize([alpha * wo[0], alpha * wo[1], wo[2]]);
     let len2 = vh[0] * vh[0] + vh[1] * vh[1];
     let t1 = if len2 > 0.0 {

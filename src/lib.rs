@@ -12,6 +12,7 @@ pub mod accumulation;
 pub mod aov;
 pub mod atomic_write;
 pub mod bench;
+pub mod clearcoat_energy;
 pub mod cli;
 pub mod compare;
 pub mod cpu;

@@ -11,7 +11,7 @@ use crate::texel_windows::TexelBinding;
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 36] = [
+pub const SHADER_PARTS: [(&str, &str); 37] = [
     ("types.wgsl", include_str!("../shaders/types.wgsl")),
     ("rng.wgsl", include_str!("../shaders/rng.wgsl")),
     ("camera.wgsl", include_str!("../shaders/camera.wgsl")),
@@ -55,6 +55,10 @@ pub const SHADER_PARTS: [(&str, &str); 36] = [
     (
         "sheen_energy.wgsl",
         include_str!("../shaders/sheen_energy.wgsl"),
+    ),
+    (
+        "clearcoat_energy.wgsl",
+        include_str!("../shaders/clearcoat_energy.wgsl"),
     ),
     ("clearcoat.wgsl", include_str!("../shaders/clearcoat.wgsl")),
     ("sheen.wgsl", include_str!("../shaders/sheen.wgsl")),

@@ -281,8 +281,10 @@ fn rust_structs_match_wgsl_layout() {
     );
 }
 
+/// The kernel's constants that mirror the host's: material kinds, alpha modes, and the sizes
+/// and offsets of the energy tables it indexes.
 #[test]
-fn material_kind_constants_match() {
+fn wgsl_constants_match_the_hosts() {
     let module = parse_and_validate();
     let constant = |name: &str| {
         let (_, c) = module
@@ -295,6 +297,8 @@ fn material_kind_constants_match() {
             ref e => panic!("{name} is {e:?}"),
         }
     };
+    use glint::clearcoat_energy as c;
+    use glint::ggx_energy as g;
     use glint::shader_types as t;
     for (name, value) in [
         ("MATERIAL_DIFFUSE", t::MATERIAL_DIFFUSE),
@@ -307,6 +311,20 @@ fn material_kind_constants_match() {
         ("ALPHA_MASK", t::ALPHA_MASK),
         ("ALPHA_BLEND", t::ALPHA_BLEND),
         ("WIDE_EMPTY_CHILD", t::WIDE_EMPTY_CHILD),
+        ("GGX_ENERGY_SIZE", g::GGX_ENERGY_SIZE as u32),
+        ("GGX_ENERGY_OFFSET_A", g::OFFSET_A as u32),
+        ("GGX_ENERGY_OFFSET_B", g::OFFSET_B as u32),
+        ("GGX_ENERGY_OFFSET_A_AVERAGE", g::OFFSET_A_AVERAGE as u32),
+        ("GGX_ENERGY_OFFSET_B_AVERAGE", g::OFFSET_B_AVERAGE as u32),
+        ("GGX_ENERGY_OFFSET_AA_AVERAGE", g::OFFSET_AA_AVERAGE as u32),
+        ("GGX_ENERGY_OFFSET_AB_AVERAGE", g::OFFSET_AB_AVERAGE as u32),
+        ("GGX_ENERGY_OFFSET_BB_AVERAGE", g::OFFSET_BB_AVERAGE as u32),
+        (
+            "SHEEN_ENERGY_SIZE",
+            glint::sheen_energy::SHEEN_ENERGY_SIZE as u32,
+        ),
+        ("CLEARCOAT_ENERGY_SIZE", c::CLEARCOAT_ENERGY_SIZE as u32),
+        ("CLEARCOAT_ENERGY_PART", c::CLEARCOAT_ENERGY_PART as u32),
     ] {
         assert_eq!(constant(name), value, "{name}");
     }

@@ -116,13 +116,9 @@ const WHITE_STACKS: [(f32, f32); 7] = [
 /// reciprocal albedo scaling keeps the white furnace within 1% at every coat roughness (0 is
 /// the coat's smallest α, 10⁻³), plus 5 standard errors of the estimate (from the sample
 /// weights' variance). Measured before the GGX tables were spaced in roughness and the coat's
-/// and the base's scalings normalised together: up to 2.5% off for coat roughness 0.1.
-/// Except under a smooth coat over glossy metal: the metal's specular lobe is dimmed by
-/// min(1 − c L(μo), 1 − c L(μi)) (clearcoat.rs), which loses where the lobe spreads over
-/// angles at which the smooth coat's albedo changes fast: measured up to −4.3% over full
-/// metal of roughness 0.5 under a coat of roughness 0 or 0.1 (−2.9% over half metal of
-/// roughness 0.3, −2.8% over metal of roughness 1), and −1.35% under a coat of roughness 0.5;
-/// so 5% and 2% there. Smooth metal (a mirror, where the min is exact) keeps 1%.
+/// and the base's scalings normalised together: up to 2.5% off for coat roughness 0.1. Before
+/// the specular lobes' scaling was normalised over their spread (`src/clearcoat_energy.rs`):
+/// up to −4.3% over full metal of roughness 0.5 under a coat of roughness 0 or 0.1.
 #[test]
 fn a_coat_over_a_white_pbr_stack_reflects_everything() {
     let mut worst = 0.0f64;
@@ -136,20 +132,12 @@ fn a_coat_over_a_white_pbr_stack_reflects_everything() {
             for mu in [0.05, 0.2, 0.5, 0.8, 1.0] {
                 let (mean, error) = albedo(&m, mu, 40_000, 12);
                 worst = worst.max((mean - 1.0).abs());
-                // Glossy metal under a smooth or medium coat: see above.
-                let bound = if metallic > 0.0 && roughness > 0.0 && coat_roughness < 0.5 {
-                    0.05
-                } else if metallic > 0.0 && roughness > 0.0 && coat_roughness < 1.0 {
-                    0.02
-                } else {
-                    0.01
-                };
                 if std::env::var("GLINT_PRINT_FURNACE").is_ok() {
                     eprintln!("coat {coat_roughness} metallic {metallic} roughness {roughness} mu {mu}: {mean:.4} ± {error:.4}");
                     continue;
                 }
                 assert!(
-                    (mean - 1.0).abs() < bound + 5.0 * error,
+                    (mean - 1.0).abs() < 0.01 + 5.0 * error,
                     "coat roughness {coat_roughness}, metallic {metallic}, roughness \
                      {roughness}, cos θo {mu}: albedo {mean} ± {error}"
                 );
@@ -186,13 +174,14 @@ fn tilted(degrees: f32, phi: f32) -> Vec3 {
 /// stack never creates energy: the coat's lobe is cut where the base's surface ends, and the
 /// base is dimmed by the coat's albedo about the coat's normal, so the albedo stays ≤ 1 (plus
 /// 5 standard errors of the estimate, from the sample weights' variance). What the tilt loses
-/// is bounded too, so a change that darkens tilted coats more fails: measured, up to 42%
+/// is bounded too, so a change that darkens tilted coats more fails: measured, up to 35% (42%
+/// before the coat's scaling of specular lobes was normalised over their spread)
 /// (metal under a smooth coat tilted 15°, cos θo 0.2, whose mirror direction grazes the
 /// coat's horizon, where the coat reflects nearly all), within 5% for the rough coat over the
 /// dielectric stack but at the 30° tilt's grazing cases.
 #[test]
 fn a_tilted_coat_over_a_white_stack_creates_no_energy() {
-    const LOSS: f64 = 0.45;
+    const LOSS: f64 = 0.40;
     let mut worst = (0.0f64, 0.0f64);
     for coat_roughness in [0.1, 0.5] {
         for (metallic, roughness) in [(0.0, 0.5), (1.0, 0.3)] {

@@ -10,22 +10,24 @@
 //!   multiple scattering, sheen) as `pbr.rs` scales its diffuse base:
 //!   (1 − c L(μo))(1 − c L(μi)) / (1 − c L_avg), whose sum with the coat is exactly 1 over a
 //!   white Lambertian base. Specular lobes, whose light leaves near μi ≈ μo, by
-//!   min(1 − c L(μo), 1 − c L(μi)), which is 1 − c L(μo) for a mirror and never more: the
-//!   first form loses 12% at grazing angles over a smooth base, where both factors are small,
-//!   and √ of the product or their mean gain up to 11–14% over glossy metal (all measured by
-//!   tests/pbr.rs's furnace). The base's diffuse and multiple-scattering lobes, which their
-//!   own layer scales the same way, are normalised with the coat's scaling together
-//!   ([`clearcoat_coupling`]). So a coat over a white stack keeps nearly all the energy
-//!   (within 1% at every coat roughness, but up to 4.3% lost under a smooth coat over glossy
-//!   metal: README.md), which F_coat's scaling does not (it cannot see the light the coat's
-//!   rough lobe misses).
+//!   1 − c · min(1, max(L(μo), L(μi)) h(μo) h(μi)), each part of their Schlick Fresnel with
+//!   its own h (`crate::clearcoat_energy`, which solves h so that the lobe keeps exactly
+//!   1 − c L(μo)); with h = 1 that is min(1 − c L(μo), 1 − c L(μi)), exact for a mirror but
+//!   up to 4.3% short over glossy metal. The product form loses 12% at grazing angles over a
+//!   smooth base, where both factors are small, and √ of the product or their mean gain up to
+//!   11–14% over glossy metal (all measured by tests/pbr.rs's furnace). The base's diffuse and
+//!   multiple-scattering lobes, which their own layer scales the same way, are normalised with
+//!   the coat's scaling together ([`clearcoat_coupling`]). So a coat over a white stack keeps
+//!   its energy (within 1% at every coat roughness: README.md), which F_coat's scaling does
+//!   not (it cannot see the light the coat's rough lobe misses).
 //!
 //! L comes from the GGX tables of `ggx_energy.rs`: f0 · A + B + F_ms (1 − E).
 
+use super::clearcoat_energy::clearcoat_narrow_scale;
 use super::frame::PI;
 use super::ggx_energy::{ggx_albedo, ggx_albedo_average, ggx_albedo_product_average};
 use super::microfacet::{ggx_d, ggx_lambda};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// The coat's Fresnel at normal incidence: ior 1.5.
 pub const CLEARCOAT_F0: f32 = 0.04;
@@ -50,6 +52,10 @@ pub struct ClearcoatLobe {
     pub specular_albedo_o: f32,
     /// c times the multiple-scattering albedo at μo (the mixture's cosine lobe samples it).
     pub ms_albedo_o: f32,
+    /// The α of the specular lobes below, and the factor h(μo) of their scaling
+    /// (`crate::clearcoat_energy`).
+    base_alpha: f32,
+    narrow_scale_o: Vec2,
 }
 
 /// The coat's whole albedo L from its split-sum parts.
@@ -68,9 +74,12 @@ pub const NO_CLEARCOAT: ClearcoatLobe = ClearcoatLobe {
     albedo_average: 0.0,
     specular_albedo_o: 0.0,
     ms_albedo_o: 0.0,
+    base_alpha: 1.0,
+    narrow_scale_o: Vec2::ONE,
 };
 
-pub fn clearcoat_lobe(weight: f32, alpha: f32, mu_o: f32) -> ClearcoatLobe {
+/// The coat of weight c and α over specular lobes of α `base_alpha`, seen from μo.
+pub fn clearcoat_lobe(weight: f32, alpha: f32, mu_o: f32, base_alpha: f32) -> ClearcoatLobe {
     let alpha = alpha.max(CLEARCOAT_MIN_ALPHA);
     let (a_o, b_o) = ggx_albedo(mu_o, alpha);
     let (a_average, b_average) = ggx_albedo_average(alpha);
@@ -88,6 +97,8 @@ pub fn clearcoat_lobe(weight: f32, alpha: f32, mu_o: f32) -> ClearcoatLobe {
         albedo_average: layer_albedo(a_average, b_average, e_average, ms),
         specular_albedo_o: weight * (CLEARCOAT_F0 * a_o + b_o),
         ms_albedo_o: weight * ms * (1.0 - e_o),
+        base_alpha,
+        narrow_scale_o: clearcoat_narrow_scale(mu_o, base_alpha, alpha),
     }
 }
 
@@ -133,7 +144,9 @@ pub fn clearcoat_transmitted_o(l: &ClearcoatLobe) -> f32 {
 pub struct ClearcoatEval {
     pub f_cos: f32,
     pub below_broad: f32,
-    pub below_narrow: f32,
+    /// For the two parts of a specular lobe: weighted by 1 − (1 − cos θh)⁵ and by
+    /// (1 − cos θh)⁵ (Schlick's f0 and f90 terms).
+    pub below_narrow: Vec2,
 }
 
 /// The coat for wo, wi in the coat's local frame (about its own normal). With either below the
@@ -149,7 +162,9 @@ pub fn clearcoat_eval(l: &ClearcoatLobe, wo: Vec3, wi: Vec3) -> ClearcoatEval {
     let passed = (1.0 - l.weight * l.albedo_o) * (1.0 - l.weight * albedo_i);
     let room = 1.0 - l.weight * l.albedo_average;
     let below_broad = if room > 0.0 { passed / room } else { 0.0 };
-    let below_narrow = (1.0 - l.weight * l.albedo_o).min(1.0 - l.weight * albedo_i);
+    let narrow_scale_i = clearcoat_narrow_scale(wi.z.abs(), l.base_alpha, l.alpha);
+    let larger = l.albedo_o.max(albedo_i) * l.narrow_scale_o * narrow_scale_i;
+    let below_narrow = Vec2::ONE - l.weight * larger.min(Vec2::ONE);
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return ClearcoatEval {
             f_cos: 0.0,

@@ -8,7 +8,7 @@ use crate::ggx_energy::{
 };
 
 /// The row below `alpha` and the weight of the one above: rows are evenly spaced in √α.
-fn alpha_row(alpha: f32) -> (usize, f32) {
+pub(super) fn alpha_row(alpha: f32) -> (usize, f32) {
     let y = (alpha.sqrt() * (GGX_ENERGY_SIZE - 1) as f32).clamp(0.0, (GGX_ENERGY_SIZE - 1) as f32);
     let j = (y as usize).min(GGX_ENERGY_SIZE - 2);
     (j, y - j as f32)

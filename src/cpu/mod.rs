@@ -9,6 +9,7 @@ pub mod bsdf;
 pub mod bvh;
 pub mod camera;
 pub mod clearcoat;
+pub mod clearcoat_energy;
 pub mod conductor;
 pub mod dielectric;
 pub mod dielectric_energy;

@@ -184,7 +184,7 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> P
     // against the stack's (which they dim), each within [0.1, 0.45] when present.
     // Only materials with a coat or a sheen read their tables.
     let coat = if m.clearcoat > 0.0 {
-        clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, coat_mu_o)
+        clearcoat_lobe(m.clearcoat, m.clearcoat_alpha, coat_mu_o, alpha)
     } else {
         NO_CLEARCOAT
     };
@@ -274,16 +274,15 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3, coat_wo: Vec3, coat_wi: Ve
     let h = (wo + wi).normalize();
     let c = (1.0 - wo.dot(h)).clamp(0.0, 1.0);
     let s5 = c * c * c * c * c;
-    let f_dielectric = l.dielectric_f0 + (l.dielectric_f90 - l.dielectric_f0) * s5;
-    let f_metal = l.base + (Vec3::ONE - l.base) * s5;
-    let fresnel = opaque * f_dielectric + l.metallic * f_metal;
     let g2 = 1.0 / (1.0 + ggx_lambda(wo, l.alpha) + ggx_lambda(wi, l.alpha));
-    let specular = fresnel * (ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z));
+    let dg = ggx_d(h.z, l.alpha) * g2 / (4.0 * wo.z);
+    // The specular lobes (GGX, and the transmission lobe's reflection) apart from the broad
+    // ones: the coat scales them as narrow lobes (clearcoat.rs), the two parts of Schlick's
+    // Fresnel f0 (1 − s⁵) + f90 s⁵ each by its own factor.
+    let mut narrow_f0 = (opaque * l.dielectric_f0 + l.metallic * l.base) * ((1.0 - s5) * dg);
+    let mut narrow_f90 = Vec3::splat((opaque * l.dielectric_f90 + l.metallic) * s5 * dg);
     let (a_i, b_i) = ggx_albedo(wi.z, l.alpha);
     let e_i = a_i + b_i;
-    // The specular lobes (GGX, and the transmission lobe's reflection) apart from the broad
-    // ones: the coat scales them as narrow lobes (clearcoat.rs).
-    let mut narrow = specular;
     let mut out = Vec3::ZERO;
     if l.e_average < 1.0 {
         let ms = opaque * l.ms_dielectric + l.metallic * l.ms_metal;
@@ -315,18 +314,23 @@ pub fn pbr_eval(lobes: &PbrLobes, wo: Vec3, wi: Vec3, coat_wo: Vec3, coat_wi: Ve
     );
     out += opaque * l.base * base_weight * l.coat_diffuse_coupling * (wi.z / PI);
     if transmissive > 0.0 {
-        narrow += Vec3::splat(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
+        // Its exact Fresnel is f90-like: small head-on, all of the reflection at grazing.
+        narrow_f90 += Vec3::splat(transmissive * rough_dielectric_eval(l.alpha, l.etap, wo, wi));
     }
     if l.sheen.color.max_element() > 0.0 {
         let (sheen, below) = sheen_eval(&l.sheen, wo, wi);
         out = sheen + below * out;
-        narrow *= below;
+        narrow_f0 *= below;
+        narrow_f90 *= below;
     }
     if l.coat.weight > 0.0 {
         let coat = clearcoat_eval(&l.coat, coat_wo, coat_wi);
-        return Vec3::splat(coat.f_cos) + coat.below_broad * out + coat.below_narrow * narrow;
+        return Vec3::splat(coat.f_cos)
+            + coat.below_broad * out
+            + coat.below_narrow.x * narrow_f0
+            + coat.below_narrow.y * narrow_f90;
     }
-    out + narrow
+    out + narrow_f0 + narrow_f90
 }
 
 /// The mixture pdf of [`pbr_sample`]; wo and wi in the base's local frame, coat_wo and coat_wi

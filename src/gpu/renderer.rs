@@ -413,6 +413,14 @@ impl<'a> GpuRenderer<'a> {
             &[]
         };
         let sheen_energy = storage_buffer(ctx, "sheen energy table", sheen_energy);
+        // The coat's scaling of the specular lobes below it (src/clearcoat_energy.rs), a
+        // placeholder without a coat.
+        let clearcoat_energy: &[f32] = if variant.features.pbr && variant.features.clearcoat {
+            crate::clearcoat_energy::clearcoat_energy_table()
+        } else {
+            &[]
+        };
+        let clearcoat_energy = storage_buffer(ctx, "clear coat energy table", clearcoat_energy);
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -512,6 +520,7 @@ impl<'a> GpuRenderer<'a> {
             (25, read_only, &ggx_energy),
             (33, read_only, &dielectric_energy),
             (32, read_only, &sheen_energy),
+            (36, read_only, &clearcoat_energy),
         ]
         .into_iter()
         .chain(hardware_buffers)

@@ -169,6 +169,11 @@ fn run_probe_with(
         "dielectric energy",
         glint::dielectric_energy::dielectric_energy_table(),
     );
+    let clearcoat_energy = storage_buffer(
+        ctx,
+        "clear coat energy",
+        glint::clearcoat_energy::clearcoat_energy_table(),
+    );
     let sheen_energy = storage_buffer(
         ctx,
         "sheen energy",
@@ -225,6 +230,7 @@ fn run_probe_with(
             (25, read_only, &ggx_energy),
             (33, read_only, &dielectric_energy),
             (32, read_only, &sheen_energy),
+            (36, read_only, &clearcoat_energy),
         ]
         .into_iter()
         .chain(hardware)
