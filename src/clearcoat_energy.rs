@@ -36,7 +36,7 @@ use crate::ggx_energy::{
     ggx_energy_table, grid_alpha, grid_mu, lambda, visible_normal, GGX_ENERGY_SIZE, OFFSET_A,
     OFFSET_A_AVERAGE, OFFSET_B, OFFSET_B_AVERAGE,
 };
-use rayon::prelude::*;
+use crate::table_threads::rows_in_parallel;
 use std::sync::OnceLock;
 
 /// The coat's Fresnel at normal incidence (ior 1.5), as `src/cpu/clearcoat.rs`'s.
@@ -78,22 +78,20 @@ fn compute_table() -> Vec<f32> {
     let n = CLEARCOAT_ENERGY_SIZE;
     let coat_albedos: Vec<Vec<f64>> = (0..n).map(coat_albedo_row).collect();
     // Per base row: h for each part and coat row, (part, jc, i).
-    let per_base: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map(|jb| {
-            let mut rows = vec![0.0; 2 * n * n];
-            for (part, transfer) in base_transfer(grid_alpha(jb)).iter().enumerate() {
-                // From the roughest coat to the smoothest, each starting from the solution
-                // of the one before (the smooth coats' fixed points are the slow ones).
-                let mut h = vec![1.0; n];
-                for jc in (0..n).rev() {
-                    h = narrow_scale(transfer, &coat_albedos[jc], h);
-                    rows[(part * n + jc) * n..][..n].copy_from_slice(&h);
-                }
+    let base_row = |jb: usize| {
+        let mut rows = vec![0.0; 2 * n * n];
+        for (part, transfer) in base_transfer(grid_alpha(jb)).iter().enumerate() {
+            // From the roughest coat to the smoothest, each starting from the solution of the
+            // one before (the smooth coats' fixed points are the slow ones).
+            let mut h = vec![1.0; n];
+            for jc in (0..n).rev() {
+                h = narrow_scale(transfer, &coat_albedos[jc], h);
+                rows[(part * n + jc) * n..][..n].copy_from_slice(&h);
             }
-            rows
-        })
-        .collect();
+        }
+        rows
+    };
+    let per_base = rows_in_parallel(n, base_row);
     let mut table = vec![0.0f32; CLEARCOAT_ENERGY_LEN];
     for (jb, rows) in per_base.iter().enumerate() {
         for part in 0..2 {

@@ -21,8 +21,8 @@
 use crate::cpu::dielectric::fresnel_dielectric;
 use crate::cpu::rough_dielectric::single_scattering_albedo_sample;
 use crate::scene::limits::MAX_IOR;
+use crate::table_threads::rows_in_parallel;
 use glam::Vec3;
-use rayon::prelude::*;
 use std::sync::OnceLock;
 
 /// Grid points along μ (at (i + ½)/N), α (at j/(N − 1)) and r (at k/(N − 1) · R_MAX).
@@ -75,17 +75,14 @@ fn compute_table() -> Vec<f32> {
         DIELECTRIC_ENERGY_ETA,
     );
     // One row of E over μ per (side, r, α), in table order.
-    let rows: Vec<Vec<f64>> = (0..2 * ne * na)
-        .into_par_iter()
-        .map(|row| {
-            let (side, k, j) = (row / (ne * na), (row / na) % ne, row % na);
-            let eta = grid_eta(k);
-            let etap = if side == 0 { eta } else { 1.0 / eta };
-            (0..nm)
-                .map(|i| albedo(grid_mu(i), grid_alpha(j), etap))
-                .collect()
-        })
-        .collect();
+    let rows: Vec<Vec<f64>> = rows_in_parallel(2 * ne * na, |row| {
+        let (side, k, j) = (row / (ne * na), (row / na) % ne, row % na);
+        let eta = grid_eta(k);
+        let etap = if side == 0 { eta } else { 1.0 / eta };
+        (0..nm)
+            .map(|i| albedo(grid_mu(i), grid_alpha(j), etap))
+            .collect()
+    });
     let mut table = vec![0.0f32; DIELECTRIC_ENERGY_LEN];
     for (row, values) in rows.iter().enumerate() {
         for (i, v) in values.iter().enumerate() {

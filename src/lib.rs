@@ -34,6 +34,7 @@ pub mod shader;
 pub mod shader_types;
 pub mod sheen_energy;
 pub mod stdio;
+pub mod table_threads;
 pub mod texel_windows;
 pub mod tonemap;
 pub mod viewer;
