@@ -8,9 +8,10 @@ const CLEARCOAT_ENERGY_SIZE: u32 = 32u;
 // Values per part (h_A, then h_B).
 const CLEARCOAT_ENERGY_PART: u32 = 32768u;
 
-fn clearcoat_energy_part(offset: u32, i: u32, t: f32, base: GgxRow, coat: GgxRow) -> f32 {
+fn clearcoat_energy_part(offset: u32, column: GgxColumn, base: GgxRow, coat: GgxRow) -> f32 {
     let n = CLEARCOAT_ENERGY_SIZE;
-    let at00 = offset + (coat.j * n + base.j) * n + i;
+    let t = column.t;
+    let at00 = offset + (coat.j * n + base.j) * n + column.i;
     let at01 = at00 + n;
     let at10 = at00 + n * n;
     let at11 = at10 + n;
@@ -26,14 +27,11 @@ fn clearcoat_energy_part(offset: u32, i: u32, t: f32, base: GgxRow, coat: GgxRow
 // (h_A, h_B)(mu, alpha_base, alpha_coat): the factors of the coat's scaling of the two parts
 // of a specular lobe below it at one end.
 fn clearcoat_narrow_scale(mu: f32, alpha_base: f32, alpha_coat: f32) -> vec2<f32> {
-    let n = f32(CLEARCOAT_ENERGY_SIZE);
-    let x = clamp(mu * n - 0.5, 0.0, n - 1.0);
-    let i = min(u32(x), CLEARCOAT_ENERGY_SIZE - 2u);
-    let t = x - f32(i);
+    let column = ggx_mu_column(mu);
     let base = ggx_alpha_row(alpha_base);
     let coat = ggx_alpha_row(alpha_coat);
     return vec2<f32>(
-        clearcoat_energy_part(0u, i, t, base, coat),
-        clearcoat_energy_part(CLEARCOAT_ENERGY_PART, i, t, base, coat)
+        clearcoat_energy_part(0u, column, base, coat),
+        clearcoat_energy_part(CLEARCOAT_ENERGY_PART, column, base, coat)
     );
 }

@@ -25,6 +25,20 @@ fn ggx_alpha_row(alpha: f32) -> GgxRow {
     return GgxRow(j, y - f32(j));
 }
 
+// The column below cos(theta) = mu and the weight of the one after: columns sit at
+// (i + 1/2) / N, and read as constant beyond the first and the last.
+struct GgxColumn {
+    i: u32,
+    t: f32,
+}
+
+fn ggx_mu_column(mu: f32) -> GgxColumn {
+    let n = f32(GGX_ENERGY_SIZE);
+    let x = clamp(mu * n - 0.5, 0.0, n - 1.0);
+    let i = min(u32(x), GGX_ENERGY_SIZE - 2u);
+    return GgxColumn(i, x - f32(i));
+}
+
 fn ggx_table_bilinear(offset: u32, i: u32, t: f32, row: GgxRow) -> f32 {
     let row0 = offset + row.j * GGX_ENERGY_SIZE + i;
     let row1 = row0 + GGX_ENERGY_SIZE;
@@ -36,14 +50,11 @@ fn ggx_table_bilinear(offset: u32, i: u32, t: f32, row: GgxRow) -> f32 {
 // (A, B) at cos(theta) = mu and alpha: the split-sum albedo f0 A + f90 B of a GGX lobe with
 // Schlick's Fresnel.
 fn ggx_albedo(mu: f32, alpha: f32) -> vec2<f32> {
-    let n = f32(GGX_ENERGY_SIZE);
-    let x = clamp(mu * n - 0.5, 0.0, n - 1.0);
-    let i = min(u32(x), GGX_ENERGY_SIZE - 2u);
-    let t = x - f32(i);
+    let column = ggx_mu_column(mu);
     let row = ggx_alpha_row(alpha);
     return vec2<f32>(
-        ggx_table_bilinear(GGX_ENERGY_OFFSET_A, i, t, row),
-        ggx_table_bilinear(GGX_ENERGY_OFFSET_B, i, t, row)
+        ggx_table_bilinear(GGX_ENERGY_OFFSET_A, column.i, column.t, row),
+        ggx_table_bilinear(GGX_ENERGY_OFFSET_B, column.i, column.t, row)
     );
 }
 

@@ -33,8 +33,8 @@
 //! and the CPU reference.
 
 use crate::ggx_energy::{
-    ggx_energy_table, grid_alpha, grid_mu, lambda, visible_normal, GGX_ENERGY_SIZE, OFFSET_A,
-    OFFSET_A_AVERAGE, OFFSET_B, OFFSET_B_AVERAGE,
+    for_each_reflection, ggx_energy_table, grid_alpha, grid_mu, interpolate_row, row_position,
+    GGX_ENERGY_SIZE, OFFSET_A, OFFSET_A_AVERAGE, OFFSET_B, OFFSET_B_AVERAGE,
 };
 use crate::table_threads::rows_in_parallel;
 use std::sync::OnceLock;
@@ -123,19 +123,9 @@ fn coat_albedo_row(jc: usize) -> Vec<f64> {
         .collect()
 }
 
-/// A row of values at the grid's μ read at `mu` as the kernel reads it: linear between grid
-/// points, constant beyond the first and the last.
-fn interpolate(row: &[f64], mu: f64) -> f64 {
-    let n = row.len();
-    let x = (mu * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-    let i = (x.floor() as usize).min(n - 2);
-    let t = x - i as f64;
-    row[i] * (1.0 - t) + row[i + 1] * t
-}
-
 /// The two parts of GGX reflection of roughness α from each grid μo, with the weights
-/// 1 − (1 − cos θh)⁵ and (1 − cos θh)⁵, gathered by μi, with the stratification of
-/// `crate::ggx_energy::albedo_split_at_resolution`.
+/// 1 − (1 − cos θh)⁵ and (1 − cos θh)⁵, gathered by μi: the reflections the GGX tables sum
+/// (`crate::ggx_energy::for_each_reflection`).
 fn base_transfer(alpha: f64) -> [Transfer; 2] {
     let n = CLEARCOAT_ENERGY_SIZE;
     let mut parts = [0, 1].map(|_| Transfer {
@@ -144,34 +134,14 @@ fn base_transfer(alpha: f64) -> [Transfer; 2] {
     });
     let count = (RADIAL_STRATA * AZIMUTHAL_STRATA) as f64;
     for i in 0..n {
-        let mu = grid_mu(i);
-        let wo = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
-        let lambda_o = lambda(wo, alpha);
-        for sr in 0..RADIAL_STRATA {
-            let v = (sr as f64 + 0.5) / RADIAL_STRATA as f64;
-            let u_radial = 1.0 - (1.0 - v).powi(3);
-            let jacobian = 3.0 * (1.0 - v).powi(2);
-            for sa in 0..AZIMUTHAL_STRATA {
-                let u_azimuthal = (sa as f64 + 0.5) / AZIMUTHAL_STRATA as f64;
-                let h = visible_normal(wo, alpha, (u_radial, u_azimuthal));
-                let c = wo[0] * h[0] + wo[1] * h[1] + wo[2] * h[2];
-                let wi = [
-                    2.0 * c * h[0] - wo[0],
-                    2.0 * c * h[1] - wo[1],
-                    2.0 * c * h[2] - wo[2],
-                ];
-                if wi[2] <= 0.0 {
-                    continue;
-                }
-                let w = jacobian * (1.0 + lambda_o) / (1.0 + lambda_o + lambda(wi, alpha)) / count;
-                let s5 = (1.0 - c).clamp(0.0, 1.0).powi(5);
-                let at = i * MU_BINS + ((wi[2] * MU_BINS as f64) as usize).min(MU_BINS - 1);
-                for (part, share) in parts.iter_mut().zip([1.0 - s5, s5]) {
-                    part.weight[at] += w * share;
-                    part.mean_mu[at] += w * share * wi[2];
-                }
+        let reflect = |wi: [f64; 3], s5: f64, weight: f64| {
+            let at = i * MU_BINS + ((wi[2] * MU_BINS as f64) as usize).min(MU_BINS - 1);
+            for (part, share) in parts.iter_mut().zip([1.0 - s5, s5]) {
+                part.weight[at] += weight / count * share;
+                part.mean_mu[at] += weight / count * share * wi[2];
             }
-        }
+        };
+        for_each_reflection(grid_mu(i), alpha, RADIAL_STRATA, AZIMUTHAL_STRATA, reflect);
     }
     for part in &mut parts {
         for (m, w) in part.mean_mu.iter_mut().zip(&part.weight) {
@@ -188,7 +158,7 @@ fn base_transfer(alpha: f64) -> [Transfer; 2] {
 fn narrow_scale(transfer: &Transfer, coat_albedo: &[f64], start: Vec<f64>) -> Vec<f64> {
     let n = CLEARCOAT_ENERGY_SIZE;
     // The bins each grid μo reaches: the weight, max(L(μo), L(μi)), and where the mean μi
-    // falls between the grid's μ (as `interpolate` reads h there); and the target L(μo) E(μo).
+    // falls between the grid's μ (as `interpolate_row` reads h there); and the target L(μo) E(μo).
     struct Reached {
         weight: f64,
         larger: f64,
@@ -206,13 +176,12 @@ fn narrow_scale(transfer: &Transfer, coat_albedo: &[f64], start: Vec<f64>) -> Ve
             if weight <= 0.0 {
                 continue;
             }
-            let x = (mu * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-            let below = (x.floor() as usize).min(n - 2);
+            let (below, t) = row_position(n, mu);
             bins.push(Reached {
                 weight,
-                larger: l_o.max(interpolate(coat_albedo, mu)),
+                larger: l_o.max(interpolate_row(coat_albedo, mu)),
                 below,
-                t: x - below as f64,
+                t,
             });
             target[i] += weight * l_o;
         }
@@ -271,8 +240,9 @@ mod tests {
                         for k in 0..MU_BINS {
                             let at = i * MU_BINS + k;
                             let mu_i = transfer.mean_mu[at];
-                            let scaled =
-                                l[i].max(interpolate(&l, mu_i)) * h[i] * interpolate(&h, mu_i);
+                            let scaled = l[i].max(interpolate_row(&l, mu_i))
+                                * h[i]
+                                * interpolate_row(&h, mu_i);
                             kept += transfer.weight[at] * scaled.min(1.0);
                             e += transfer.weight[at];
                         }

@@ -93,19 +93,27 @@ fn compute_table() -> Vec<f32> {
     table
 }
 
+/// Where `mu` falls on a row of `n` values at the grid's μ, as the kernel reads it: the point
+/// below and the weight of the one above (constant beyond the first and the last point).
+pub(crate) fn row_position(n: usize, mu: f64) -> (usize, f64) {
+    let x = (mu * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+    let i = (x.floor() as usize).min(n - 2);
+    (i, x - i as f64)
+}
+
+/// A row of values at the grid's μ read at `mu`, linear between its points ([`row_position`]).
+pub(crate) fn interpolate_row(row: &[f64], mu: f64) -> f64 {
+    let (i, t) = row_position(row.len(), mu);
+    row[i] * (1.0 - t) + row[i + 1] * t
+}
+
 /// 2∫f(μ)g(μ)μ dμ of the piecewise-linear interpolants of two rows (values at the grid's μ,
 /// constant beyond its first and last points), as the kernel interpolates them. Between
 /// neighbouring grid points (and beyond the ends) the integrand is a cubic in μ, which
 /// Simpson's rule integrates exactly.
 fn hemispherical_average(f: &[f64], g: &[f64]) -> f64 {
     let n = f.len();
-    let interpolated = |row: &[f64], mu: f64| {
-        let x = (mu * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-        let i = (x.floor() as usize).min(n - 2);
-        let t = x - i as f64;
-        row[i] * (1.0 - t) + row[i + 1] * t
-    };
-    let integrand = |mu: f64| 2.0 * interpolated(f, mu) * interpolated(g, mu) * mu;
+    let integrand = |mu: f64| 2.0 * interpolate_row(f, mu) * interpolate_row(g, mu) * mu;
     let mut breaks = vec![0.0];
     breaks.extend((0..n).map(grid_mu));
     breaks.push(1.0);
@@ -139,9 +147,29 @@ pub fn albedo_split_at_resolution(
     radial: usize,
     azimuthal: usize,
 ) -> (f64, f64) {
+    let (mut a, mut b) = (0.0, 0.0);
+    for_each_reflection(mu, alpha, radial, azimuthal, |_, s5, weight| {
+        a += weight * (1.0 - s5);
+        b += weight * s5;
+    });
+    let count = (radial * azimuthal) as f64;
+    (a / count, b / count)
+}
+
+/// GGX reflection of roughness α from cos θo = μ (wo in the xz plane), one reflection per
+/// stratum of the sampler of visible normals (stratified as [`albedo_split_at_resolution`]
+/// says): `reflection(wi, s5, weight)` for each wi above the surface, with s5 = (1 − cos θh)⁵
+/// and weight = du/dv · G2/G1, whose sum divided by radial × azimuthal is the albedo with
+/// F = 1. The coat's table (`crate::clearcoat_energy`) gathers the same reflections by wi.
+pub(crate) fn for_each_reflection(
+    mu: f64,
+    alpha: f64,
+    radial: usize,
+    azimuthal: usize,
+    mut reflection: impl FnMut([f64; 3], f64, f64),
+) {
     let wo = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
     let lambda_o = lambda(wo, alpha);
-    let (mut a, mut b) = (0.0, 0.0);
     for sr in 0..radial {
         let v = (sr as f64 + 0.5) / radial as f64;
         let u_radial = 1.0 - (1.0 - v).powi(3);
@@ -160,12 +188,9 @@ pub fn albedo_split_at_resolution(
             }
             let weight = jacobian * (1.0 + lambda_o) / (1.0 + lambda_o + lambda(wi, alpha));
             let s5 = (1.0 - c).clamp(0.0, 1.0).powi(5);
-            a += weight * (1.0 - s5);
-            b += weight * s5;
+            reflection(wi, s5, weight);
         }
     }
-    let count = (radial * azimuthal) as f64;
-    (a / count, b / count)
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -178,13 +203,13 @@ fn normalize(v: [f64; 3]) -> [f64; 3] {
 }
 
 /// Smith's Λ for GGX.
-pub(crate) fn lambda(w: [f64; 3], alpha: f64) -> f64 {
+fn lambda(w: [f64; 3], alpha: f64) -> f64 {
     let x = alpha * alpha * (w[0] * w[0] + w[1] * w[1]) / (w[2] * w[2]).max(1e-300);
     x / (2.0 * (1.0 + (1.0 + x).sqrt()))
 }
 
 /// Heitz's sampling of visible normals (JCGT 2018), as in `src/cpu/microfacet.rs`.
-pub(crate) fn visible_normal(wo: [f64; 3], alpha: f64, u: (f64, f64)) -> [f64; 3] {
+fn visible_normal(wo: [f64; 3], alpha: f64, u: (f64, f64)) -> [f64; 3] {
     let vh = normalize([alpha * wo[0], alpha * wo[1], wo[2]]);
     let len2 = vh[0] * vh[0] + vh[1] * vh[1];
     let t1 = if len2 > 0.0 {

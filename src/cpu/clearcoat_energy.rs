@@ -3,7 +3,7 @@
 //! in μ = cos θ, the base's roughness √α and the coat's, on the GGX tables' grid, the same f32
 //! operations on both sides.
 
-use super::ggx_energy::alpha_row;
+use super::ggx_energy::{alpha_row, mu_column};
 use crate::clearcoat_energy::{
     clearcoat_energy_table, CLEARCOAT_ENERGY_PART, CLEARCOAT_ENERGY_SIZE,
 };
@@ -14,9 +14,7 @@ use glam::Vec2;
 pub fn clearcoat_narrow_scale(mu: f32, alpha_base: f32, alpha_coat: f32) -> Vec2 {
     let table = clearcoat_energy_table();
     let n = CLEARCOAT_ENERGY_SIZE;
-    let x = (mu * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
-    let i = (x as usize).min(n - 2);
-    let t = x - i as f32;
+    let (i, t) = mu_column(mu);
     let (jb, sb) = alpha_row(alpha_base);
     let (jc, sc) = alpha_row(alpha_coat);
     let part = |offset: usize| {

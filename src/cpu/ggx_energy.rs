@@ -14,14 +14,21 @@ pub(super) fn alpha_row(alpha: f32) -> (usize, f32) {
     (j, y - j as f32)
 }
 
+/// The column below cos θ = `mu` and the weight of the one after: columns sit at (i + ½)/N,
+/// and read as constant beyond the first and the last.
+pub(super) fn mu_column(mu: f32) -> (usize, f32) {
+    let n = GGX_ENERGY_SIZE;
+    let x = (mu * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
+    let i = (x as usize).min(n - 2);
+    (i, x - i as f32)
+}
+
 /// (A, B) at cos θ = `mu` and `alpha`: the split-sum albedo f0·A + f90·B of a GGX lobe with
 /// Schlick's Fresnel.
 pub fn ggx_albedo(mu: f32, alpha: f32) -> (f32, f32) {
     let table = ggx_energy_table();
     let n = GGX_ENERGY_SIZE;
-    let x = (mu * n as f32 - 0.5).clamp(0.0, (n - 1) as f32);
-    let i = (x as usize).min(n - 2);
-    let t = x - i as f32;
+    let (i, t) = mu_column(mu);
     let (j, s) = alpha_row(alpha);
     let at = |offset: usize| {
         let row0 = offset + j * n + i;
