@@ -39,8 +39,9 @@ use crate::ggx_energy::{
 use crate::table_threads::rows_in_parallel;
 use std::sync::OnceLock;
 
-/// The coat's Fresnel at normal incidence (ior 1.5), as `src/cpu/clearcoat.rs`'s.
-const COAT_F0: f64 = 0.04;
+/// The coat's Fresnel at normal incidence (ior 1.5), which `src/cpu/clearcoat.rs` uses too.
+pub const CLEARCOAT_F0: f32 = 0.04;
+const COAT_F0: f64 = CLEARCOAT_F0 as f64;
 /// Bins of μi the base lobe's transfer is gathered into (each keeps its weighted mean μi).
 const MU_BINS: usize = 64;
 /// Strata of the base lobe's sampler at each grid μo: radial and azimuthal.

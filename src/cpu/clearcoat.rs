@@ -29,8 +29,7 @@ use super::ggx_energy::{ggx_albedo, ggx_albedo_average, ggx_albedo_product_avera
 use super::microfacet::{ggx_d, ggx_lambda};
 use glam::{Vec2, Vec3};
 
-/// The coat's Fresnel at normal incidence: ior 1.5.
-pub const CLEARCOAT_F0: f32 = 0.04;
+pub use crate::clearcoat_energy::CLEARCOAT_F0;
 /// The smallest α of the coat (roughness 0.032), as the pbr material's own.
 pub const CLEARCOAT_MIN_ALPHA: f32 = 1e-3;
 
