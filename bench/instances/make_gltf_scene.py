@@ -3,7 +3,7 @@
 /tmp/glint-instances-gltf): reuse.gltf, a UV sphere of 2,000 triangles (positions, normals,
 u32 indices) used by 1,000 nodes in a 10 x 10 x 10 grid, and reuse.toml, the Cornell box
 (scenes/cornell.toml) with the grid in it (2*10^6 placed triangles, 2*10^3 unique). glTF
-reuse is stored once (README.md, "Instances"); before, it was flattened."""
+reuse is stored once (docs/src/reference/meshes.md, "Instances"); before, it was flattened."""
 import base64
 import json
 import math

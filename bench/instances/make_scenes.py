@@ -2,7 +2,8 @@
 """Writes the instancing benchmark's scenes into OUT (default /tmp/glint-instances): the Cornell
 box (scenes/cornell.toml) with a 100 x 100 grid of small bumpy spheres on its floor, placed
 once by one [[meshes]] entry's `instances` (instanced.toml) and once by 10^4 [[meshes]]
-entries (flattened.toml). The mesh is written by `glint stress-mesh` (see README.md)."""
+entries (flattened.toml). The mesh is written by `glint stress-mesh` (see
+docs/src/reference/meshes.md)."""
 import pathlib
 import sys
 

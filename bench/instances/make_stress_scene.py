@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Writes the two-level structure's stress scene into OUT (default /tmp/glint-instances-stress):
 the Cornell box (scenes/cornell.toml) with 10^4 instances of the 10^6-triangle stress mesh
-(`glint stress-mesh OUT/mesh.ply`, see README.md) in a 100 x 100 grid on its floor, placed by
-one [[meshes]] entry's `instances` (stress.toml): 10^10 placed triangles, 10^6 stored."""
+(`glint stress-mesh OUT/mesh.ply`, see docs/src/reference/meshes.md) in a 100 x 100 grid on
+its floor, placed by one [[meshes]] entry's `instances` (stress.toml): 10^10 placed triangles,
+10^6 stored."""
 import pathlib
 import sys
 

@@ -20,7 +20,8 @@ bounces=${BOUNCES:-8}
 glint=${GLINT:-target/release/glint}
 devices=${DEVICES:-gpu cpu mitsuba}
 
-# lavapipe wants a private runtime folder and a writable shader cache (see README.md).
+# lavapipe wants a private runtime folder and a writable shader cache (see
+# docs/src/guide/install.md).
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/xdg-$(id -un)}
 mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 export MESA_SHADER_CACHE_DIR=${MESA_SHADER_CACHE_DIR:-$PWD/target/mesa-shader-cache}
