@@ -331,7 +331,7 @@ impl SceneBinding {
 /// a lane takes it, so code a scene cannot reach still costs time on every segment (compiling
 /// out light sampling halves the time of a render without it). On real GPUs it saves
 /// registers. Each flag only removes code that cannot run for the scene, so images do not
-/// change (tests/scene_binding.rs).
+/// change (tests/suite/scene_binding.rs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct KernelFeatures {
     /// Next-event estimation with MIS (`Params::light_sampling`, with at least one emitter).
@@ -533,6 +533,51 @@ impl KernelVariant {
             features: KernelFeatures::of(scene),
         }
     }
+
+    /// [`KernelVariant::for_scene`]'s kernel with storage buffers where that has uniform ones:
+    /// the same features, but nothing of the scene's size compiled in, so that scenes using
+    /// the same features share one kernel. It renders the same image
+    /// (tests/suite/scene_binding.rs), a little more slowly. (A kernel with every feature
+    /// would serve every scene, but lavapipe takes minutes to compile it.)
+    pub fn shared_for(scene: &KernelScene, max_uniform_binding: u64) -> KernelVariant {
+        let fastest = KernelVariant::for_scene(scene, max_uniform_binding);
+        match fastest.binding {
+            SceneBinding::Uniform(_) => KernelVariant {
+                binding: SceneBinding::Storage,
+                ..fastest
+            },
+            _ => fastest,
+        }
+    }
+
+    /// The kernel a renderer takes unless told otherwise: [`KernelVariant::for_scene`]'s, or
+    /// [`KernelVariant::shared_for`]'s where `GLINT_KERNEL_VARIANT=shared` says so. On
+    /// lavapipe, compiling a kernel takes seconds and rendering a test's few pixels
+    /// milliseconds, so the test suite (scripts/test) renders through shared kernels; the
+    /// uniform variants themselves are tested by asking for them.
+    pub fn default_for(scene: &KernelScene, max_uniform_binding: u64) -> KernelVariant {
+        if shared_kernel_requested() {
+            KernelVariant::shared_for(scene, max_uniform_binding)
+        } else {
+            KernelVariant::for_scene(scene, max_uniform_binding)
+        }
+    }
+}
+
+/// `GLINT_KERNEL_VARIANT`, read once: `shared` or `fastest` (the default); anything else is
+/// ignored with a warning.
+fn shared_kernel_requested() -> bool {
+    static SHARED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *SHARED.get_or_init(|| match std::env::var("GLINT_KERNEL_VARIANT").as_deref() {
+        Ok("shared") => true,
+        Ok("fastest") | Err(_) => false,
+        Ok(other) => {
+            crate::errln!(
+                "glint: GLINT_KERNEL_VARIANT={other} is neither shared nor fastest; ignored"
+            );
+            false
+        }
+    })
 }
 
 /// The whole kernel as one WGSL module, for any scene ([`KernelVariant::GENERAL`]).

@@ -18,8 +18,7 @@ use crate::shader_types::{
 };
 use glam::{Vec3, Vec3A};
 
-/// Enough for any tree the host builds: it bounds every tree's depth by this.
-pub const BVH_STACK_SIZE: usize = 64;
+pub use crate::scene::bvh::BVH_STACK_SIZE;
 
 /// No shadow target: [`bvh_traverse`] looks for the closest hit.
 pub const NO_PRIMITIVE: u32 = u32::MAX;

@@ -38,11 +38,25 @@ pub fn compute_bind_group_with_tlas(
     buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
     tlas: Option<(u32, &wgpu::Tlas)>,
 ) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &compute_layout_entries(buffers, tlas.map(|(binding, _)| binding)),
+    });
+    let group = bind_group(device, label, &layout, buffers, tlas);
+    (layout, group)
+}
+
+/// The layout entries of [`compute_bind_group_with_tlas`]: what a pipeline's bind group
+/// layout is made of, and part of what a cached pipeline is looked up by.
+pub fn compute_layout_entries(
+    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
+    tlas_binding: Option<u32>,
+) -> Vec<wgpu::BindGroupLayoutEntry> {
     let mut entries: Vec<_> = buffers
         .iter()
         .map(|&(binding, ty, _)| buffer_layout_entry(binding, ty, wgpu::ShaderStages::COMPUTE))
         .collect();
-    if let Some((binding, _)) = tlas {
+    if let Some(binding) = tlas_binding {
         entries.push(wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -52,10 +66,17 @@ pub fn compute_bind_group_with_tlas(
             count: None,
         });
     }
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &entries,
-    });
+    entries
+}
+
+/// The bind group binding `buffers` (and the TLAS, where given) to `layout`.
+pub fn bind_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
+    tlas: Option<(u32, &wgpu::Tlas)>,
+) -> wgpu::BindGroup {
     let mut entries: Vec<_> = buffers
         .iter()
         .map(|&(binding, _, buffer)| wgpu::BindGroupEntry {
@@ -69,12 +90,11 @@ pub fn compute_bind_group_with_tlas(
             resource: tlas.as_binding(),
         });
     }
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some(label),
-        layout: &layout,
+        layout,
         entries: &entries,
-    });
-    (layout, group)
+    })
 }
 
 /// A compute pipeline running `entry_point` of `module` with `layout` as its one bind group.

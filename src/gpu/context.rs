@@ -1,6 +1,8 @@
 //! The Vulkan device glint renders on.
 
-use std::sync::{Arc, Mutex};
+use sha2::{Digest, Sha256};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Why no GPU could be used.
 #[derive(Debug, thiserror::Error)]
@@ -16,6 +18,29 @@ pub struct GpuContext {
     pub adapter_info: wgpu::AdapterInfo,
     pub features: wgpu::Features,
     errors: Arc<Mutex<Vec<String>>>,
+    /// Compute pipelines made on this device, by [`PipelineKey`]: a second renderer of the same
+    /// kernel (the test suite's many renders, the viewer's reloads, Python's renders) reuses
+    /// the pipeline instead of translating and compiling the kernel again (lavapipe: seconds).
+    pipelines: Mutex<HashMap<PipelineKey, Arc<OnceLock<CachedPipeline>>>>,
+}
+
+type CachedPipeline = Option<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>;
+
+/// What a compute pipeline is made of: a digest of the kernel's source, its entry point and
+/// its bind group layout's entries.
+type PipelineKey = [u8; 32];
+
+fn pipeline_key(
+    source: &str,
+    entry_point: &str,
+    layout_entries: &[wgpu::BindGroupLayoutEntry],
+) -> PipelineKey {
+    let mut digest = Sha256::new();
+    for part in [source, entry_point, &format!("{layout_entries:?}")] {
+        digest.update((part.len() as u64).to_le_bytes());
+        digest.update(part.as_bytes());
+    }
+    digest.finalize().into()
 }
 
 /// Creates the folder Mesa keeps its shader cache in, before the Vulkan devices are enumerated
@@ -95,7 +120,7 @@ impl GpuContext {
             // SAFETY: the one experimental feature asked for is ray queries, used only by the
             // hardware traversal's kernel variant and its acceleration structure
             // (src/gpu/acceleration.rs), tested against the software traversal
-            // (tests/hardware_traversal.rs).
+            // (tests/suite/hardware_traversal.rs).
             experimental_features: if features.contains(wgpu::Features::EXPERIMENTAL_RAY_QUERY) {
                 unsafe { wgpu::ExperimentalFeatures::enabled() }
             } else {
@@ -117,7 +142,63 @@ impl GpuContext {
             adapter_info,
             features,
             errors,
+            pipelines: Mutex::new(HashMap::new()),
         })
+    }
+
+    /// The bind group layout and compute pipeline for `entry_point` of the WGSL `source` with
+    /// one bind group of `layout_entries`: made once per device, then shared. Bind groups for
+    /// it must be made with the layout returned here.
+    pub fn compute_pipeline(
+        &self,
+        label: &str,
+        source: &str,
+        entry_point: &str,
+        layout_entries: &[wgpu::BindGroupLayoutEntry],
+    ) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
+        let key = pipeline_key(source, entry_point, layout_entries);
+        // The map is locked only to find the slot: different kernels compile in parallel,
+        // and two threads asking for the same kernel compile it once.
+        let slot = self
+            .pipelines
+            .lock()
+            .unwrap()
+            .entry(key)
+            .or_default()
+            .clone();
+        let make = || {
+            let errors_before = self.errors.lock().unwrap().len();
+            let layout = self
+                .device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries: layout_entries,
+                });
+            let module = self
+                .device
+                .create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(label),
+                    source: wgpu::ShaderSource::Wgsl(source.into()),
+                });
+            let pipeline = super::binding::compute_pipeline(
+                &self.device,
+                label,
+                &layout,
+                &module,
+                entry_point,
+            );
+            let refused = self.errors.lock().unwrap().len() != errors_before;
+            (layout, pipeline, refused)
+        };
+        if let Some(made) = slot.get_or_init(|| {
+            let (layout, pipeline, refused) = make();
+            // A pipeline the device refused is not kept: the next caller gets the error again.
+            (!refused).then_some((layout, pipeline))
+        }) {
+            return made.clone();
+        }
+        let (layout, pipeline, _) = make();
+        (layout, pipeline)
     }
 
     /// The first error the device reported since the last call, if any.

@@ -1,7 +1,7 @@
 //! The GPU renderer: scene upload, sample batches, readback of the running sums.
 
 use super::acceleration::AccelerationStructure;
-use super::binding::{compute_bind_group_with_tlas, compute_pipeline};
+use super::binding::{bind_group, compute_layout_entries};
 use super::context::GpuContext;
 use super::inline_uniforms::params_binding_for;
 use super::limits::{check_buffers, BufferBinding, BufferNeed};
@@ -141,8 +141,19 @@ fn scene_buffer<T: Pod + Default>(
 impl<'a> GpuRenderer<'a> {
     /// A renderer for `scene` with the fastest kernel for it: its objects in uniform buffers
     /// when they fit the device's limit (storage buffers otherwise), and only the features it
-    /// uses compiled in.
+    /// uses compiled in; or a kernel shared by scenes where `GLINT_KERNEL_VARIANT=shared`
+    /// ([`KernelVariant::default_for`]).
     pub fn new(ctx: &'a GpuContext, scene: &KernelScene) -> Result<GpuRenderer<'a>> {
+        let max_uniform = ctx.device.limits().max_uniform_buffer_binding_size;
+        Self::with_variant(ctx, scene, KernelVariant::default_for(scene, max_uniform))
+    }
+
+    /// A renderer with [`KernelVariant::for_scene`]'s kernel whatever `GLINT_KERNEL_VARIANT`
+    /// says: for tests of that choice.
+    pub fn with_fastest_kernel(
+        ctx: &'a GpuContext,
+        scene: &KernelScene,
+    ) -> Result<GpuRenderer<'a>> {
         let max_uniform = ctx.device.limits().max_uniform_buffer_binding_size;
         Self::with_variant(ctx, scene, KernelVariant::for_scene(scene, max_uniform))
     }
@@ -196,7 +207,7 @@ impl<'a> GpuRenderer<'a> {
         window_bytes: u64,
     ) -> Result<GpuRenderer<'a>> {
         let max_uniform = ctx.device.limits().max_uniform_buffer_binding_size;
-        let variant = KernelVariant::for_scene(scene, max_uniform);
+        let variant = KernelVariant::default_for(scene, max_uniform);
         Self::with_variant_and_texel_window(ctx, scene, variant, window_bytes)
     }
 
@@ -530,25 +541,14 @@ impl<'a> GpuRenderer<'a> {
         if texel_binding.is_split() {
             check_storage_binding_count(&limits, &buffers)?;
         }
-        let (bind_group_layout, bind_group) = compute_bind_group_with_tlas(
-            device,
-            "scene",
-            &buffers,
-            acceleration.as_ref().map(|a| (26, &a.tlas)),
-        );
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("glint render kernel"),
-            source: wgpu::ShaderSource::Wgsl(
-                render_kernel_source_with_texels(variant, params_binding, texel_binding).into(),
-            ),
-        });
-        let pipeline = compute_pipeline(
-            device,
-            "glint render",
-            &bind_group_layout,
-            &module,
+        let tlas = acceleration.as_ref().map(|a| (26, &a.tlas));
+        let (bind_group_layout, pipeline) = ctx.compute_pipeline(
+            "glint render kernel",
+            &render_kernel_source_with_texels(variant, params_binding, texel_binding),
             RENDER_ENTRY_POINT,
+            &compute_layout_entries(&buffers, tlas.map(|(binding, _)| binding)),
         );
+        let bind_group = bind_group(device, "scene", &bind_group_layout, &buffers, tlas);
         ctx.wait_idle()?;
         let renderer = GpuRenderer {
             ctx,

@@ -3,7 +3,6 @@
 //! into the compact node array that the kernel (`shaders/bvh.wgsl`) and the CPU mirror
 //! (`src/cpu/bvh.rs`) traverse.
 
-use crate::cpu::bvh::BVH_STACK_SIZE;
 use crate::shader_types::{
     BvhNode, Quad, Sphere, Triangle, PRIMITIVE_INDEX_MASK, PRIMITIVE_INSTANCE,
     PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
@@ -13,6 +12,10 @@ use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
 use obvhs::BvhBuildParams;
 use std::time::{Duration, Instant};
+
+/// The traversal stack's length on both devices: enough for any tree the host builds, as it
+/// bounds every tree's depth by this.
+pub const BVH_STACK_SIZE: usize = 64;
 
 /// Scenes with at most this many spheres and quads and no triangles keep the linear scan (and
 /// the uniform-buffer kernel): for a handful of primitives, testing them all beats any tree.

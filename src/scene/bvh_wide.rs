@@ -5,7 +5,7 @@
 //! primitives in the same boxes and the box test's slack guarantees carry over. Traversed by
 //! `shaders/traverse/wide.wgsl` and `src/cpu/traverse/wide.rs`.
 
-use crate::cpu::bvh::BVH_STACK_SIZE;
+use crate::scene::bvh::BVH_STACK_SIZE;
 use crate::shader_types::{BvhNode, BvhWideNode, WIDE_EMPTY_CHILD};
 use std::collections::VecDeque;
 
