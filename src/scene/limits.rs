@@ -22,6 +22,10 @@ pub const MAX_RADIANCE: f64 = 1e10;
 pub const MIN_IOR: f32 = 0.01;
 pub const MAX_IOR: f32 = 100.0;
 
+/// Largest magnitude of a normal map's `scale` (glTF allows any finite number): the scaled
+/// tangent-space xy stays within f32's range after squaring.
+pub const MAX_NORMAL_SCALE: f64 = 1e6;
+
 /// Smallest sine of the angle between the camera's `up` and its view direction, and between
 /// a quad's two edges: below it the basis (or the quad's normal) is not well defined in f32.
 pub const MIN_SINE: f64 = 1e-6;

@@ -110,7 +110,7 @@ pub struct InstancedMesh {
 impl Scene {
     /// The same scene with every instanced mesh copied into `triangles`, placement after
     /// placement, after the scene's own triangles: what the two-level structure must render
-    /// the same as (tests/instancing.rs).
+    /// the same as (tests/suite/instancing.rs).
     pub fn flattened(&self) -> Scene {
         let mut scene = self.clone();
         for mesh in std::mem::take(&mut scene.instanced) {

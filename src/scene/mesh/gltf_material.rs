@@ -3,7 +3,7 @@
 //! (the geometry is read in `gltf.rs`).
 
 use super::gltf::exists;
-use super::{check_emission, check_ior, check_reflectance};
+use super::{check_emission, check_ior, check_normal_scale, check_reflectance};
 use crate::scene::texture::Sampling;
 use crate::scene::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
 use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
@@ -71,13 +71,13 @@ pub(super) fn material(
     let pbr = &m.pbr_metallic_roughness;
     let transmission = extensions.and_then(|e| e.transmission.as_ref());
     let volume = extensions.and_then(|e| e.volume.as_ref());
-    // glTF's ior 0 is a special case glint cannot render; its default is 1.5.
-    let ior = extensions
-        .and_then(|e| e.ior.as_ref())
-        .map(|i| i.ior.0)
-        .filter(|&n| n > 0.0)
-        .unwrap_or(1.5);
-    let ior = check_ior(&name, "KHR_materials_ior", ior)?;
+    // glTF's ior 0 (a Fresnel of 1 at every angle) is a special case glint cannot render;
+    // its default is 1.5. Any other value passes the scene file's range check.
+    let ior = match extensions.and_then(|e| e.ior.as_ref()).map(|i| i.ior.0) {
+        None => 1.5,
+        Some(n) if n == 0.0 => 1.5,
+        Some(n) => check_ior(&name, "KHR_materials_ior.ior", n)?,
+    };
     let clearcoat: Option<ClearcoatJson> = raw_extension(m, index, "KHR_materials_clearcoat")?;
     let sheen: Option<SheenJson> = raw_extension(m, index, "KHR_materials_sheen")?;
     let kind = {
@@ -255,9 +255,11 @@ pub(super) fn material(
     let mut normal_image =
         |n: &json::material::NormalTexture, path: &str| -> Result<Option<NormalImage>, String> {
             let field = format!("materials[{index}].{path}");
-            if !n.scale.is_finite() {
-                return Err(format!("{field}.scale: not finite"));
-            }
+            check_normal_scale(
+                &format!("material{index}"),
+                &format!("{field}.scale"),
+                n.scale,
+            )?;
             // The crate keeps a normal texture's extensions unparsed.
             let transform = n
                 .extensions

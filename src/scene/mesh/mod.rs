@@ -20,10 +20,11 @@ mod ply;
 mod reuse;
 mod tangents;
 
+pub use self::gltf::{ExtensionSupport, GLTF_EXTENSIONS};
 pub use gltf_cameras::{gltf_camera, no_such_camera, FileCamera};
 pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
-use super::limits::{MAX_IOR, MAX_RADIANCE, MIN_IOR};
+use super::limits::{MAX_IOR, MAX_NORMAL_SCALE, MAX_RADIANCE, MIN_IOR};
 use super::texture::{Sampling, TextureSet, TextureUse};
 use super::{InstancedMesh, Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
@@ -664,6 +665,17 @@ fn check_ior(name: &str, what: &str, ior: f32) -> Result<f32, String> {
         ));
     }
     Ok(ior)
+}
+
+/// A normal map's scale within glint's numeric range, as in scene files.
+fn check_normal_scale(material: &str, what: &str, scale: f32) -> Result<f32, String> {
+    if !scale.is_finite() || f64::from(scale.abs()) > MAX_NORMAL_SCALE {
+        return Err(format!(
+            "material {material:?}: {what} must be a number in [-{MAX_NORMAL_SCALE:e}, \
+             {MAX_NORMAL_SCALE:e}] (the numeric range glint supports), got {scale}"
+        ));
+    }
+    Ok(scale)
 }
 
 /// The bytes of a mesh file, if it is a regular file within [`MESH_FILE_LIMIT`].

@@ -1,8 +1,8 @@
 //! OBJ files and their `.mtl` materials, read by `tobj`.
 
 use super::{
-    check_emission, check_ior, check_reflectance, read_mesh_bytes, FileTextures, Geometry,
-    ImageSource, MeshFile, MeshPart,
+    check_emission, check_ior, check_normal_scale, check_reflectance, read_mesh_bytes,
+    FileTextures, Geometry, ImageSource, MeshFile, MeshPart,
 };
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Alpha, AlphaMode, Material, MaterialKind};
@@ -119,7 +119,13 @@ fn obj_material(
         (None, None) => 1.0,
     };
     let is_pbr = PBR_STATEMENTS.iter().any(|k| param(k).is_some());
-    let ior = m.optical_density.filter(|&n| n > 0.0).unwrap_or(1.5);
+    // Checked whatever the material's kind, as a scene file's `ior` is. Exporters write `Ni 0`
+    // (Blender for some materials, 3ds Max) where they mean no index: that is the default.
+    let ior = match m.optical_density {
+        None => 1.5,
+        Some(n) if n == 0.0 => 1.5,
+        Some(n) => check_ior(name, "Ni", n)?,
+    };
     let kind = if is_pbr {
         let roughness = match number("Pr")? {
             Some(r) => unit("Pr", r)?,
@@ -130,7 +136,7 @@ fn obj_material(
         MaterialKind::Pbr {
             roughness,
             metallic: unit("Pm", number("Pm")?.unwrap_or(0.0))?,
-            ior: check_ior(name, "Ni", ior)?,
+            ior,
             specular: 1.0,
             specular_color: Vec3::ONE,
             transmission: 0.0,
@@ -217,12 +223,7 @@ fn obj_material(
         None => ("map_Bump", m.normal_texture.as_deref()),
     };
     if let Some((file, scale)) = map(normal, normal_key)? {
-        let scale = scale.unwrap_or(1.0);
-        if !scale.is_finite() {
-            return Err(format!(
-                "material {name:?}: {normal_key}: -bm is not finite"
-            ));
-        }
+        let scale = check_normal_scale(name, &format!("{normal_key}'s -bm"), scale.unwrap_or(1.0))?;
         maps.normal = Some((
             (Rc::new(ImageSource::File(file)), Default::default()),
             scale,

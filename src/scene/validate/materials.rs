@@ -2,7 +2,7 @@
 //! materials by name.
 
 use super::super::file::{MaterialToml, Real, RoughnessToml, S};
-use super::super::limits::{MAX_IOR, MIN_IOR};
+use super::super::limits::{MAX_IOR, MAX_NORMAL_SCALE, MIN_IOR};
 use super::super::texture::{TextureSet, TextureUse};
 use super::super::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
 use super::fields::{fail, non_negative, radiance_in_range, real, vec3, FieldError};
@@ -557,7 +557,7 @@ fn normal_map(
             };
             let scale = table_scale(x, table, field)?;
             // glTF's scale may be any finite number; within f32's range here.
-            if !scale.is_finite() || scale.abs() > 1e6 {
+            if !scale.is_finite() || scale.abs() > MAX_NORMAL_SCALE {
                 return fail(
                     x.span(),
                     format!("{field}.scale"),
