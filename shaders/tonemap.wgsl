@@ -1,5 +1,5 @@
 // Tone mapping for the viewer's display pass: the GPU mirror of src/tonemap.rs (same curves,
-// same constants, same names; tests/viewer_display.rs checks the two agree). Linear radiance
+// same constants, same names; tests/suite/viewer_display.rs checks the two agree). Linear radiance
 // × 2^exposure → a display-linear value in [0, 1]; the caller sRGB-encodes it.
 
 // Curve codes, as src/viewer/display.rs writes them into the uniform.

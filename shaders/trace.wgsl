@@ -77,7 +77,7 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     // else the unmapped one; the base's normal map does not reach it. Normalised again (the
     // same vector but for rounding) so that no kernel variant can prove it the base's and
     // merge the coat's arithmetic with the base's: every variant rounds the coat alike
-    // (tests/scene_binding.rs). Only where a coat is compiled in: nothing else reads it.
+    // (tests/suite/scene_binding.rs). Only where a coat is compiled in: nothing else reads it.
     var coat_normal = hit.shading_normal;
     if HAS_CLEARCOAT {
         coat_normal = normalize(coat_normal);

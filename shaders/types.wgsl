@@ -1,5 +1,5 @@
 // Data shared by every kernel stage. The Rust side is src/shader_types.rs; the test
-// tests/layout.rs checks with naga's layouter that both agree field by field.
+// tests/suite/layout.rs checks with naga's layouter that both agree field by field.
 
 struct Params {
     eye: vec3<f32>,

@@ -7,7 +7,7 @@
 //! 1 − c max(L(μo), L(μi)) is symmetric and exact for a mirror, but a glossy lobe spreads wi
 //! over angles where L is larger than at μo (towards grazing, where a smooth coat's L climbs
 //! from 0.04 to 1), and lost up to 4.3% of white metal's energy under a smooth coat
-//! (tests/pbr.rs's coat furnace). So the lobe is scaled by
+//! (tests/suite/pbr.rs's coat furnace). So the lobe is scaled by
 //!
 //! 1 − c · min(1, max(L(μo), L(μi)) · h(μo) h(μi)),
 //!

@@ -17,7 +17,7 @@
 //! The α axis is spaced evenly in roughness, not in α: the albedo changes fastest at small α
 //! (a smooth lobe's grazing shadowing), where rows evenly spaced in α put nothing between
 //! α = 0.001 and 0.032, and reading a roughness-0.1 coat between them was off by 2% of its
-//! albedo at cos θ 0.05 (tests/pbr.rs's table test).
+//! albedo at cos θ 0.05 (tests/suite/pbr.rs's table test).
 //!
 //! They are computed here, at first use, by integrating with the kernel's own sampler (the
 //! distribution of visible normals) on a stratified grid in f64: deterministic, about 0.15 s,

@@ -1,6 +1,6 @@
 //! The structs the kernel reads, byte for byte (WGSL side: `shaders/types.wgsl`).
 //! The CPU reference traces from these same structs, so both devices see identical numbers.
-//! `tests/layout.rs` checks every offset and size against the WGSL with naga's layouter.
+//! `tests/suite/layout.rs` checks every offset and size against the WGSL with naga's layouter.
 
 use bytemuck::{Pod, Zeroable};
 

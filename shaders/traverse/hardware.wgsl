@@ -11,7 +11,7 @@
 // instance are the software traversal's. That test includes alpha
 // (hit_scene_triangle, shaders/alpha.wgsl): a candidate in a hole, or that a blended triangle
 // lets through, is rejected like a miss, so no geometry needs other flags for alpha. No CPU mirror: the CPU traces with
-// the software BVH (src/cpu/bvh.rs), which this must agree with (tests/closest_hit.rs).
+// the software BVH (src/cpu/bvh.rs), which this must agree with (tests/suite/closest_hit.rs).
 
 @group(0) @binding(26) var scene_tlas: acceleration_structure;
 // The reference ((kind << PRIMITIVE_KIND_SHIFT) | index) of every primitive in the TLAS: a

@@ -180,7 +180,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     args.post.configure(&mut kernel_scene.params);
     let settings = &scene.render;
     let (width, height) = (settings.width, settings.height);
-    // AOVs leave the image bit for bit the same (tests/aov.rs), so --denoise's --raw file
+    // AOVs leave the image bit for bit the same (tests/suite/aov.rs), so --denoise's --raw file
     // resumes and merges with renders made without them.
     let settings_hash = settings_hash(&KernelScene {
         params: Params {

@@ -15,7 +15,7 @@
 //!   1 − c L(μo)); with h = 1 that is min(1 − c L(μo), 1 − c L(μi)), exact for a mirror but
 //!   up to 4.3% short over glossy metal. The product form loses 12% at grazing angles over a
 //!   smooth base, where both factors are small, and √ of the product or their mean gain up to
-//!   11–14% over glossy metal (all measured by tests/pbr.rs's furnace). The base's diffuse and
+//!   11–14% over glossy metal (all measured by tests/suite/pbr.rs's furnace). The base's diffuse and
 //!   multiple-scattering lobes, which their own layer scales the same way, are normalised with
 //!   the coat's scaling together ([`clearcoat_coupling`]). So a coat over a white stack keeps
 //!   its energy (within 1% at every coat roughness: README.md), which F_coat's scaling does
@@ -109,7 +109,7 @@ pub fn clearcoat_lobe(weight: f32, alpha: f32, mu_o: f32, base_alpha: f32) -> Cl
 /// normalises by its own average 1 − L'_avg; the coat passes 1 − c L(μ) and normalises by
 /// 1 − c L_avg. Both shares fall towards grazing angles, so the average of their product is
 /// more than the product of their averages, and the two normalisations together gave up to
-/// +1.3% head-on over a smooth white dielectric base (tests/pbr.rs's coat furnace).
+/// +1.3% head-on over a smooth white dielectric base (tests/suite/pbr.rs's coat furnace).
 /// Normalising by the product's own average instead, (1 − c L_avg)(1 − L'_avg) /
 /// 2∫(1 − c L(μ))(1 − L'(μ)) μ dμ times the two scalings, makes the broad lobe's albedo
 /// exactly (1 − c L(μo))(1 − L'(μo)) over a white base. The average comes from the tables'
@@ -152,7 +152,7 @@ pub struct ClearcoatEval {
 /// coat's normal (which a normal map tilts from the base's) its lobe is black; below it, wi
 /// dims the layers under the coat as its mirror image above does (|cos θi|), continuous across
 /// the coat's horizon, where the coat reflects most. Holding the horizon's albedo beyond it
-/// instead loses up to 72% in tests/pbr.rs's tilted-coat furnace (metal under a smooth coat
+/// instead loses up to 72% in tests/suite/pbr.rs's tilted-coat furnace (metal under a smooth coat
 /// tilted 45°), |cos θi| up to 42%; neither creates energy.
 pub fn clearcoat_eval(l: &ClearcoatLobe, wo: Vec3, wi: Vec3) -> ClearcoatEval {
     let (a_i, b_i) = ggx_albedo(wi.z.abs(), l.alpha);

@@ -14,7 +14,7 @@ pub const DISPLAY_SHADER: &str = concat!(
 pub const VERTEX_ENTRY_POINT: &str = "vs_main";
 pub const FRAGMENT_ENTRY_POINT: &str = "fs_main";
 
-/// The shader's `Display` uniform, byte for byte (`tests/viewer_display.rs` checks the layout).
+/// The shader's `Display` uniform, byte for byte (`tests/suite/viewer_display.rs` checks the layout).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DisplayUniform {

@@ -1,0 +1,94 @@
+//! The GPU kernel and the CPU reference trace the same paths for the same seed: the same
+//! Cornell box rendered on both and compared pixel by pixel.
+
+use crate::common;
+use common::{gpu, render_cpu, render_gpu, PathAgreement};
+
+/// Cornell box at 64×64, 1 sample per pixel, four seeds: each pixel is one path, so comparing
+/// pixels compares paths (with light sampling nearly every path carries light). Both sides use
+/// the same random stream and the same f32 operations, but the GPU may fuse multiply-adds and
+/// its sqrt, sin and cos may differ in the last ulp, so a path that grazes an edge or a shadow
+/// boundary, or whose Russian roulette draw lands within an ulp of its threshold, can take
+/// another branch and then differs completely. We measured on lavapipe 16314 of 16384 paths
+/// (99.57%) agreeing to 1e-3, the worst of them within 2.3e-4; hence the 99% bound. A broken
+/// stream, camera, BSDF or light sampler makes almost every path differ.
+#[test]
+fn gpu_and_cpu_trace_the_same_paths() {
+    let Some(ctx) = gpu() else { return };
+    let mut agreement = PathAgreement::default();
+    for seed in [3, 4, 5, 6] {
+        let scene = common::cornell_at(64, seed);
+        agreement.add(&render_cpu(&scene, 1), &render_gpu(ctx, &scene, 1));
+    }
+    agreement.check(0.99);
+}
+
+/// A rough transmissive pbr sphere with Beer–Lambert attenuation and a half-transmissive one
+/// beside it, on a diffuse floor under a quad light, with light sampling, 48×48 at one path
+/// per pixel: refraction both ways (marked delta for MIS), attenuation inside, total internal
+/// reflection, and the mixture's lobe choice take the same paths on both devices. The bound
+/// is the Cornell box's (see above); the transmissive paths are longer, so more of them meet
+/// a branch an ulp decides.
+#[test]
+fn gpu_and_cpu_trace_the_same_paths_through_transmission() {
+    let Some(ctx) = gpu() else { return };
+    let mut agreement = PathAgreement::default();
+    for seed in [7, 8] {
+        let scene = common::sized(common::scene(TRANSMISSION_SCENE), 48, seed);
+        agreement.add(&render_cpu(&scene, 1), &render_gpu(ctx, &scene, 1));
+    }
+    agreement.check(0.99);
+}
+
+const TRANSMISSION_SCENE: &str = r#"
+[camera]
+eye = [0.0, 1.5, -5.0]
+target = [0.0, 0.8, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 35.0
+[render]
+width = 48
+height = 48
+spp = 1
+max_bounces = 12
+background = [0.1, 0.12, 0.15]
+[materials.floor]
+type = "diffuse"
+color = [0.6, 0.6, 0.6]
+[materials.light]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 0.9, 0.8]
+strength = 6.0
+[materials.glass]
+type = "pbr"
+base_color = [1.0, 1.0, 1.0]
+roughness = 0.3
+ior = 1.5
+transmission = 1.0
+attenuation_color = [0.9, 0.5, 0.2]
+attenuation_distance = 0.8
+[materials.frosted]
+type = "pbr"
+base_color = [0.4, 0.7, 0.9]
+roughness = 0.6
+transmission = 0.5
+[[spheres]]
+center = [-0.6, 0.8, 0.0]
+radius = 0.8
+material = "glass"
+[[spheres]]
+center = [1.0, 0.5, -0.5]
+radius = 0.5
+material = "frosted"
+[[quads]]
+corner = [-10.0, 0.0, -10.0]
+u = [0.0, 0.0, 20.0]
+v = [20.0, 0.0, 0.0]
+material = "floor"
+[[quads]]
+corner = [-1.0, 4.0, -1.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 0.0, 2.0]
+material = "light"
+"#;
