@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes, next to this script, for tests/model.rs:
+"""Writes, next to this script, for tests/suite/model.rs:
   lights-cameras.gltf  a glTF 2.0 file with two perspective cameras and three
                        KHR_lights_punctual lights placed by nodes, over a floor and a box;
   bare-box.glb         a binary glTF with the box alone (turned 30 degrees about +y, raised
