@@ -74,8 +74,7 @@ pub(super) fn material(
     // glTF's ior 0 (a Fresnel of 1 at every angle) is a special case glint cannot render;
     // its default is 1.5. Any other value passes the scene file's range check.
     let ior = match extensions.and_then(|e| e.ior.as_ref()).map(|i| i.ior.0) {
-        None => 1.5,
-        Some(n) if n == 0.0 => 1.5,
+        None | Some(0.0) => 1.5,
         Some(n) => check_ior(&name, "KHR_materials_ior.ior", n)?,
     };
     let clearcoat: Option<ClearcoatJson> = raw_extension(m, index, "KHR_materials_clearcoat")?;

@@ -122,8 +122,7 @@ fn obj_material(
     // Checked whatever the material's kind, as a scene file's `ior` is. Exporters write `Ni 0`
     // (Blender for some materials, 3ds Max) where they mean no index: that is the default.
     let ior = match m.optical_density {
-        None => 1.5,
-        Some(n) if n == 0.0 => 1.5,
+        None | Some(0.0) => 1.5,
         Some(n) => check_ior(name, "Ni", n)?,
     };
     let kind = if is_pbr {
