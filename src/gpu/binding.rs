@@ -19,35 +19,11 @@ pub fn buffer_layout_entry(
     }
 }
 
-/// An explicit bind group layout and the bind group binding `buffers` to it, for compute.
-/// Explicit, not taken from the pipeline: an automatic layout drops the bindings a shader
-/// does not use, and kernels with features compiled out (or probe entry points) use fewer.
-pub fn compute_bind_group(
-    device: &wgpu::Device,
-    label: &str,
-    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
-) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
-    compute_bind_group_with_tlas(device, label, buffers, None)
-}
-
-/// [`compute_bind_group`] with an acceleration structure bound too, where one is given (the
-/// hardware traversal's: shaders/traverse/hardware.wgsl).
-pub fn compute_bind_group_with_tlas(
-    device: &wgpu::Device,
-    label: &str,
-    buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
-    tlas: Option<(u32, &wgpu::Tlas)>,
-) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some(label),
-        entries: &compute_layout_entries(buffers, tlas.map(|(binding, _)| binding)),
-    });
-    let group = bind_group(device, label, &layout, buffers, tlas);
-    (layout, group)
-}
-
-/// The layout entries of [`compute_bind_group_with_tlas`]: what a pipeline's bind group
-/// layout is made of, and part of what a cached pipeline is looked up by.
+/// The layout entries of a compute bind group of whole `buffers` (and a TLAS at
+/// `tlas_binding`, the hardware traversal's: shaders/traverse/hardware.wgsl). Explicit, not
+/// taken from the pipeline: an automatic layout drops the bindings a shader does not use, and
+/// kernels with features compiled out (or probe entry points) use fewer. They are part of
+/// what `GpuContext::compute_pipeline` looks a cached pipeline up by.
 pub fn compute_layout_entries(
     buffers: &[(u32, wgpu::BufferBindingType, &wgpu::Buffer)],
     tlas_binding: Option<u32>,
