@@ -60,6 +60,17 @@ fn assert_error(mesh: &str, files: &[(&str, &[u8])], extra: &str, needles: &[&st
     }
 }
 
+/// A one-triangle OBJ using material `m` of `mtl` is refused with `needles` in the message.
+fn assert_mtl_error(mtl: &str, needles: &[&str]) {
+    let obj = format!("mtllib t.mtl\nusemtl m\n{TRIANGLE_OBJ}");
+    assert_error(
+        "t.obj",
+        &[("t.obj", obj.as_bytes()), ("t.mtl", mtl.as_bytes())],
+        "",
+        needles,
+    );
+}
+
 #[test]
 fn a_good_obj_loads() {
     let (scene, _dir) = load("t.obj", &[("t.obj", TRIANGLE_OBJ.as_bytes())], "");
@@ -608,20 +619,11 @@ fn used_extensions_get_one_warning() {
 /// Materials from mesh files get the scene's numeric range checks.
 #[test]
 fn file_materials_out_of_glints_range() {
-    let with_mtl = |mtl: &str, needles: &[&str]| {
-        let obj = format!("mtllib t.mtl\nusemtl m\n{TRIANGLE_OBJ}");
-        assert_error(
-            "t.obj",
-            &[("t.obj", obj.as_bytes()), ("t.mtl", mtl.as_bytes())],
-            "",
-            needles,
-        );
-    };
-    with_mtl(
+    assert_mtl_error(
         "newmtl m\nKe 1e30 1 1\n",
         &["material \"m\"", "Ke", "too bright"],
     );
-    with_mtl(
+    assert_mtl_error(
         "newmtl m\nPr 0.5\nNi 1000\n",
         &["material \"m\"", "Ni must be in [0.01, 100]", "1000"],
     );
@@ -674,29 +676,20 @@ fn file_materials_out_of_glints_range() {
 /// write for "no index", is the default and loads.
 #[test]
 fn mtl_values_get_the_range_checks_on_every_material_kind() {
-    let with_mtl = |mtl: &str, needles: &[&str]| {
-        let obj = format!("mtllib t.mtl\nusemtl m\n{TRIANGLE_OBJ}");
-        assert_error(
-            "t.obj",
-            &[("t.obj", obj.as_bytes()), ("t.mtl", mtl.as_bytes())],
-            "",
-            needles,
-        );
-    };
     for mtl in [
         "newmtl m\nNi 1000\n",
         "newmtl m\nKs 0.9 0.9 0.9\nillum 3\nNi 1000\n",
     ] {
-        with_mtl(
+        assert_mtl_error(
             mtl,
             &["material \"m\"", "Ni must be in [0.01, 100]", "1000"],
         );
     }
-    with_mtl(
+    assert_mtl_error(
         "newmtl m\nNi -2\n",
         &["material \"m\"", "Ni must be in [0.01, 100]", "-2"],
     );
-    with_mtl(
+    assert_mtl_error(
         "newmtl m\nnorm -bm 1e9 n.png\n",
         &["material \"m\"", "norm's -bm", "[-1e6, 1e6]"],
     );
