@@ -8,33 +8,16 @@
 // closed pipe.
 #![warn(clippy::print_stdout, clippy::print_stderr)]
 
-pub mod accumulation;
-pub mod aov;
-pub mod atomic_write;
-pub mod bench;
-pub mod clearcoat_energy;
 pub mod cli;
-pub mod compare;
 pub mod cpu;
-pub mod denoise;
-pub mod dielectric_energy;
 pub mod error;
 pub mod exr_header;
-pub mod ggx_energy;
 pub mod gpu;
+pub mod image;
 pub mod input_file;
-pub mod interrupt;
-pub mod merge;
-pub mod output;
-pub mod output_check;
-pub mod partial;
+pub mod kernel;
 pub mod render;
 pub mod scene;
-pub mod shader;
-pub mod shader_types;
-pub mod sheen_energy;
 pub mod stdio;
-pub mod table_threads;
-pub mod texel_windows;
-pub mod tonemap;
+pub mod tables;
 pub mod viewer;

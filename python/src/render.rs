@@ -6,13 +6,12 @@ use crate::images::to_numpy;
 use crate::scene::Scene;
 use crate::SceneError;
 use anyhow::anyhow;
-use glint::cpu::renderer::CpuRenderer;
+use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::error::InputError;
 use glint::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
+use glint::kernel::KernelScene;
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
-use glint::scene::{
-    self as scenes, KernelScene, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
-};
+use glint::scene::{self as scenes, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -133,11 +132,11 @@ fn checked(name: &str, value: Option<i64>, min: i64, max: i64) -> PyResult<Optio
 
 /// What a render gives back, before it becomes Python objects.
 struct Rendered {
-    mean: glint::output::Image,
-    variance: Option<glint::output::Image>,
-    aovs: Option<glint::aov::Aovs>,
+    mean: glint::image::output::Image,
+    variance: Option<glint::image::output::Image>,
+    aovs: Option<glint::render::aov::Aovs>,
     /// With denoise: OIDN's image of `mean` and the seconds it took.
-    denoised: Option<(glint::output::Image, f64)>,
+    denoised: Option<(glint::image::output::Image, f64)>,
     spp: u32,
     seconds: f64,
     stopped_by: &'static str,
@@ -212,7 +211,7 @@ fn run(
     let denoised = match (&aovs, options.denoise) {
         (Some(aovs), true) => {
             let started = Instant::now();
-            let image = glint::denoise::oidn()?.denoise(&mean, aovs)?;
+            let image = glint::image::denoise::oidn()?.denoise(&mean, aovs)?;
             Some((image, started.elapsed().as_secs_f64()))
         }
         _ => None,
@@ -326,7 +325,8 @@ pub fn render<'py>(
     };
     if denoise {
         // As `glint render --denoise` checks before rendering: the install step when missing.
-        glint::denoise::oidn().map_err(|e| PyRuntimeError::new_err(format!("denoise: {e:#}")))?;
+        glint::image::denoise::oidn()
+            .map_err(|e| PyRuntimeError::new_err(format!("denoise: {e:#}")))?;
     }
     let this = scene.get();
     let source = this.source.display().to_string();

@@ -1,7 +1,7 @@
 // The bottom level of the two-level structure (mirror: src/cpu/traverse/blas.rs): an instance
-// in the top-level BVH (shaders/bvh.wgsl) is hit by walking its mesh's own BVH, laid out in
+// in the top-level BVH (shaders/traverse/bvh.wgsl) is hit by walking its mesh's own BVH, laid out in
 // bvh_nodes after the top level's, with the ray in the mesh's coordinates
-// (shaders/instance.wgsl). The walk is bvh_traverse's, over triangles only: WGSL has no
+// (shaders/geometry/instance.wgsl). The walk is bvh_traverse's, over triangles only: WGSL has no
 // recursion nor function parameters, so the loop is written again rather than shared.
 
 // An instance's closest triangle: its t (NO_HIT for none), its index in the triangle arrays,

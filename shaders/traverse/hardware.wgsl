@@ -1,17 +1,17 @@
 // Hardware traversal with ray queries (wgpu's EXPERIMENTAL_RAY_QUERY), compiled only into the
-// hardware kernel variant (SceneBinding::Hardware in src/shader.rs): a shader that uses ray
+// hardware kernel variant (SceneBinding::Hardware in src/kernel/variant.rs): a shader that uses ray
 // queries does not compile on a device without them. The host builds the acceleration
 // structure (src/gpu/acceleration.rs): a TLAS over the triangles placed as they are (triangle
 // geometry), the spheres and quads (boxes), and one instance per placement of an instanced
 // mesh, over that mesh's triangles in its own coordinates. The hardware only proposes
 // candidates: every one, triangles included (RAY_FLAG_FORCE_NO_OPAQUE), is tested here with
-// glint's own exact test (hit_primitive, shaders/bvh.wgsl; an instance's triangle in the
+// glint's own exact test (hit_primitive, shaders/traverse/bvh.wgsl; an instance's triangle in the
 // instance's coordinates, as shaders/traverse/blas.wgsl tests it) and kept by the closest-hit
 // rule (hit_comes_first, extended by triangle within an instance), so a hit's t, primitive and
 // instance are the software traversal's. That test includes alpha
-// (hit_scene_triangle, shaders/alpha.wgsl): a candidate in a hole, or that a blended triangle
+// (hit_scene_triangle, shaders/geometry/alpha.wgsl): a candidate in a hole, or that a blended triangle
 // lets through, is rejected like a miss, so no geometry needs other flags for alpha. No CPU mirror: the CPU traces with
-// the software BVH (src/cpu/bvh.rs), which this must agree with (tests/suite/closest_hit.rs).
+// the software BVH (src/cpu/traverse/bvh.rs), which this must agree with (tests/suite/closest_hit.rs).
 
 @group(0) @binding(26) var scene_tlas: acceleration_structure;
 // The reference ((kind << PRIMITIVE_KIND_SHIFT) | index) of every primitive in the TLAS: a

@@ -1,7 +1,7 @@
 // 4-wide BVH traversal (mirror: src/cpu/traverse/wide.rs), compiled only into the wide kernel
-// variant (SceneBinding::WideBvh in src/shader.rs), over the tree src/scene/bvh_wide.rs
+// variant (SceneBinding::WideBvh in src/kernel/variant.rs), over the tree src/kernel/bvh/wide.rs
 // collapses from the binary one. The meaning and the arguments are bvh_traverse's
-// (shaders/bvh.wgsl), and so are the leaves' tests and bookkeeping (hit_primitive,
+// (shaders/traverse/bvh.wgsl), and so are the leaves' tests and bookkeeping (hit_primitive,
 // hit_comes_first, the leaf-entry pruning): only the inner nodes differ. A node's four boxes
 // are tested at once, and its children pushed farthest first, so the nearest is visited next.
 // Why wide on lavapipe: it loads each storage-buffer value with a loop over the lanes, and a
@@ -29,7 +29,7 @@ fn bvh_wide_leaf(parent: u32, slot: u32) -> vec2<u32> {
 
 // Where the ray enters each of the node's four child boxes (0 when it starts inside), or
 // NO_HIT where it misses the box, enters it beyond t_max, or the slot holds no child: each
-// child's is hit_box's arithmetic (shaders/bvh.wgsl), on four boxes at once.
+// child's is hit_box's arithmetic (shaders/traverse/bvh.wgsl), on four boxes at once.
 fn hit_wide_boxes(node: BvhWideNode, r: BvhRay, t_max: f32) -> vec4<f32> {
     let o = r.ray.origin;
     let tx0 = (node.min_x - o.x) * r.inv_dir.x;
@@ -61,7 +61,7 @@ fn farthest_first(t: vec4<f32>) -> vec4<u32> {
 }
 
 // A stack entry for a leaf: its parent's index times four plus its slot, with this bit set
-// (src/scene/bvh_wide.rs bounds the node count below 2^29).
+// (src/kernel/bvh/wide.rs bounds the node count below 2^29).
 const WIDE_LEAF: u32 = 0x80000000u;
 
 fn wide_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {

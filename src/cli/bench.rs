@@ -1,9 +1,9 @@
 //! `glint bench`.
 
-use crate::bench::{case_scene, cases, mesh_cases, run_case, BenchDevice, BenchResult};
-use crate::cpu::renderer::CpuRenderer;
+use crate::cpu::integrator::renderer::CpuRenderer;
 use crate::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
-use crate::shader::{SceneBinding, SceneCounts};
+use crate::kernel::variant::{SceneBinding, SceneCounts};
+use crate::render::bench::{case_scene, cases, mesh_cases, run_case, BenchDevice, BenchResult};
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 

@@ -1,9 +1,9 @@
 //! `glint compare`.
 
-use crate::compare::{compare, difference_image, Z_CRITICAL, Z_TEST_ALPHA};
 use crate::error::InputError;
-use crate::output::Image;
-use crate::output_check::OutputSet;
+use crate::image::compare::{compare, difference_image, Z_CRITICAL, Z_TEST_ALPHA};
+use crate::image::output::Image;
+use crate::image::output_check::OutputSet;
 use anyhow::Result;
 use clap::Args;
 use std::path::{Path, PathBuf};

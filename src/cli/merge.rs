@@ -1,9 +1,9 @@
 //! `glint merge`.
 
 use crate::error::InputError;
-use crate::merge::{merge, Part};
-use crate::output_check::OutputSet;
-use crate::partial::{format_ranges, write_image, Partial};
+use crate::image::output_check::OutputSet;
+use crate::render::merge::{merge, Part};
+use crate::render::partial::{format_ranges, write_image, Partial};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::PathBuf;
@@ -31,7 +31,7 @@ pub struct MergeArgs {
 
 pub fn run(args: MergeArgs) -> Result<()> {
     let started = Instant::now();
-    // Every output writable, none the same file as another or as a part (src/output_check.rs).
+    // Every output writable, none the same file as another or as a part (src/image/output_check.rs).
     let mut outputs = OutputSet::new();
     for part in &args.parts {
         outputs = outputs.input("a part", part);

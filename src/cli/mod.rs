@@ -87,9 +87,9 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            if let Some(interrupted) = e.downcast_ref::<crate::interrupt::Interrupted>() {
+            if let Some(interrupted) = e.downcast_ref::<crate::render::interrupt::Interrupted>() {
                 crate::errln!("glint: {interrupted}");
-                return ExitCode::from(crate::interrupt::exit_code(interrupted.signal));
+                return ExitCode::from(crate::render::interrupt::exit_code(interrupted.signal));
             }
             crate::errln!("glint: error: {e:#}");
             if e.downcast_ref::<InputError>().is_some() {

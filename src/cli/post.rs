@@ -2,13 +2,13 @@
 //! mapping for PNG, and the firefly clamp. Checked before rendering, applied after.
 
 use super::tone::ToneArgs;
-use crate::denoise;
 use crate::error::InputError;
-use crate::output::{Image, ImageFormat};
-use crate::output_check::OutputSet;
+use crate::image::denoise;
+use crate::image::output::{Image, ImageFormat};
+use crate::image::output_check::OutputSet;
+use crate::image::tonemap::DisplayTransform;
+use crate::kernel::types::Params;
 use crate::render::Renderer;
-use crate::shader_types::Params;
-use crate::tonemap::DisplayTransform;
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};

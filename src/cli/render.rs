@@ -4,20 +4,21 @@ use super::model::ModelArgs;
 use super::post::PostArgs;
 use super::render_writer::RenderWriter;
 use super::sample_range::{self, SampleRangeArgs};
-use crate::cpu::renderer::CpuRenderer;
+use crate::cpu::integrator::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer, TraversalChoice};
-use crate::interrupt::{self, Interrupted};
-use crate::output::ImageFormat;
-use crate::output_check::OutputSet;
-use crate::partial::{format_range, settings_hash, PartialInfo};
+use crate::image::output::ImageFormat;
+use crate::image::output_check::OutputSet;
+use crate::kernel::types::Params;
+use crate::kernel::KernelScene;
+use crate::render::interrupt::{self, Interrupted};
+use crate::render::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
     relative_error, render_progressive, BatchSizer, Renderer, StopRules, MIN_SPP_FOR_TARGET_ERROR,
 };
 use crate::scene::model::ModelScene;
 use crate::scene::model_toml::model_toml;
-use crate::scene::{KernelScene, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
-use crate::shader_types::Params;
+use crate::scene::{RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};

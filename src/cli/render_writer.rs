@@ -4,10 +4,10 @@
 //! next checkpoint; only a failed final write is an error. With --denoise the image goes to
 //! --raw (or nowhere), as `-o` is then the denoised image (src/cli/post.rs).
 
-use crate::output::{Image, ImageFormat};
-use crate::partial::{Partial, PartialInfo};
+use crate::image::output::{Image, ImageFormat};
+use crate::image::tonemap::DisplayTransform;
+use crate::render::partial::{Partial, PartialInfo};
 use crate::render::Renderer;
-use crate::tonemap::DisplayTransform;
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
 

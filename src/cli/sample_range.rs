@@ -3,7 +3,7 @@
 //! file from its last sample.
 
 use crate::error::InputError;
-use crate::partial::{format_range, format_ranges, parse_range, Partial};
+use crate::render::partial::{format_range, format_ranges, parse_range, Partial};
 use crate::render::Renderer;
 use anyhow::Result;
 use clap::Args;
@@ -148,7 +148,7 @@ impl RangePlan {
     }
 }
 
-/// What the render of this scene (its [`crate::partial::settings_hash`], seed, size and
+/// What the render of this scene (its [`crate::render::partial::settings_hash`], seed, size and
 /// `spp`) covers, from the flags.
 pub fn plan(
     args: &SampleRangeArgs,

@@ -1,8 +1,8 @@
 //! `glint stress-mesh`: writes the generated stress mesh (a displaced sphere) as PLY.
 
-use crate::atomic_write::write_atomically;
 use crate::error::InputError;
-use crate::output_check::OutputSet;
+use crate::image::atomic_write::write_atomically;
+use crate::image::output_check::OutputSet;
 use crate::scene::stress::StressMesh;
 use anyhow::Result;
 use clap::Args;

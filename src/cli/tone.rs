@@ -1,7 +1,7 @@
 //! `--tonemap` and `--exposure`: how radiance is shown, shared by `glint render` (PNG output)
 //! and `glint view` (the window and its PNG screenshots).
 
-use crate::tonemap::{parse_exposure, DisplayTransform, Tonemap};
+use crate::image::tonemap::{parse_exposure, DisplayTransform, Tonemap};
 use clap::Args;
 
 #[derive(Args, Debug, Default)]

@@ -9,11 +9,11 @@
 //! the instance whose index is its TLAS instance index.
 
 use super::context::GpuContext;
-use crate::scene::KernelScene;
-use crate::shader_types::{
+use crate::kernel::types::{
     PRIMITIVE_INDEX_MASK, PRIMITIVE_INSTANCE, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
     PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
+use crate::kernel::KernelScene;
 use anyhow::{anyhow, Result};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -57,7 +57,7 @@ fn padded_box(min: Vec3, max: Vec3) -> [f32; 6] {
 
 /// The triangle (a, b, c) with each edge moved outward in its plane by 2⁻¹⁴ of the size of
 /// its coordinates (and its longest edge): the hardware's triangle test rounds differently from
-/// glint's watertight one (shaders/triangle.wgsl), and a ray through an edge that glint's test
+/// glint's watertight one (shaders/geometry/triangle.wgsl), and a ray through an edge that glint's test
 /// gives to one triangle could otherwise find the hardware proposing neither of the two (as
 /// measured on lavapipe). Widened, the hardware proposes every triangle glint's test hits, and
 /// the few beyond, near the edges, glint's test rejects. A degenerate triangle (no plane), which
@@ -86,7 +86,7 @@ pub fn widened_triangle(a: [f32; 3], b: [f32; 3], c: [f32; 3]) -> [[f32; 3]; 3] 
 
 impl HardwareGeometry {
     /// The primitives the traversal must see: those of the scene's BVH where it has one (all
-    /// but exact copies, which by the closest-hit rule no ray sees: src/scene/bvh.rs; an
+    /// but exact copies, which by the closest-hit rule no ray sees: src/kernel/bvh/mod.rs; an
     /// instanced mesh's, those of its own BVH, without its copies), else every sphere and quad
     /// (a scene without a BVH has no triangles).
     pub fn of(scene: &KernelScene) -> HardwareGeometry {

@@ -10,8 +10,8 @@
 //! sample; and the kernel reports any invocation whose path loop still ended early (when a
 //! single sample needs more than the limit), which the renderer turns into an error.
 
-use crate::scene::KernelScene;
-use crate::shader_types::Params;
+use crate::kernel::types::Params;
+use crate::kernel::KernelScene;
 
 /// Loop iterations after which llvmpipe ends an invocation's loops.
 pub const LAVAPIPE_LOOP_LIMIT: u64 = 65535;
@@ -24,7 +24,7 @@ pub fn device_loop_limit(info: &wgpu::AdapterInfo) -> Option<u64> {
 }
 
 /// The most loop iterations one ray's intersection test can take. The linear scan loops over
-/// every sphere, quad and triangle. The BVH traversal (`shaders/bvh.wgsl`) makes one outer
+/// every sphere, quad and triangle. The BVH traversal (`shaders/traverse/bvh.wgsl`) makes one outer
 /// iteration per node it visits (each node at most once), one leaf-loop iteration per
 /// primitive reference it tests (each at most once), and one pop-loop iteration per stack entry
 /// (at most one push per inner node): a true worst case, far above a typical ray's few dozen.
@@ -47,7 +47,7 @@ pub fn loop_iterations_per_ray(scene: &KernelScene) -> u64 {
         .bvh_wide_nodes
         .iter()
         .flat_map(|n| n.count)
-        .filter(|&c| c != crate::shader_types::WIDE_EMPTY_CHILD)
+        .filter(|&c| c != crate::kernel::types::WIDE_EMPTY_CHILD)
         .count() as u64;
     let wide =
         1 + children + 4 * scene.bvh_wide_nodes.len() as u64 + scene.bvh_primitives.len() as u64;

@@ -11,17 +11,17 @@ use super::loop_budget::{
 };
 use super::tiles::{next_tile, TilePlanner};
 use super::traversal::Traversal;
-use crate::accumulation::Accumulation;
-use crate::aov::Aovs;
-use crate::output::Image;
-use crate::render::{check_size, variance_of_mean, Renderer};
-use crate::scene::KernelScene;
-use crate::shader::{
+use crate::image::output::Image;
+use crate::kernel::texels::{TexelBinding, EXTRA_WINDOW_BINDINGS};
+use crate::kernel::types::{BvhNode, BvhWideNode, Params};
+use crate::kernel::variant::{
     render_kernel_source_with_texels, KernelFeatures, KernelVariant, ParamsBinding, SceneBinding,
     RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
-use crate::shader_types::{BvhNode, BvhWideNode, Params};
-use crate::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS};
+use crate::kernel::KernelScene;
+use crate::render::accumulation::Accumulation;
+use crate::render::aov::Aovs;
+use crate::render::{check_size, variance_of_mean, Renderer};
 use anyhow::{anyhow, Result};
 use bytemuck::Pod;
 use wgpu::util::DeviceExt;
@@ -37,7 +37,7 @@ pub struct GpuRenderer<'a> {
     mean_buffer: wgpu::Buffer,
     /// Per pixel vec4: M2, the sum of squared deviations from the mean (xyz).
     m2_buffer: wgpu::Buffer,
-    /// Per pixel vec4s of the denoiser's AOVs (shaders/aov.wgsl): albedo and depth, normal.
+    /// Per pixel vec4s of the denoiser's AOVs (shaders/integrator/aov.wgsl): albedo and depth, normal.
     /// One vec4 each when the kernel has AOVs compiled out.
     aov_buffers: [wgpu::Buffer; 2],
     readback_buffer: wgpu::Buffer,
@@ -47,7 +47,7 @@ pub struct GpuRenderer<'a> {
     counter_buffer: wgpu::Buffer,
     /// Benchmark instrumentation, off unless asked for: it reads back after every batch.
     instruments: Option<Instruments>,
-    /// The origin of the tile a dispatch covers (`shaders/tiles.wgsl`).
+    /// The origin of the tile a dispatch covers (`shaders/integrator/tiles.wgsl`).
     tile_buffer: wgpu::Buffer,
     tiles: TilePlanner,
     /// The kernel's count of dropped samples (one u32), read and cleared after every batch.
@@ -60,7 +60,7 @@ pub struct GpuRenderer<'a> {
     loop_iterations: u64,
     /// The hardware traversal's acceleration structure, bound with the kernel (kept alive).
     _acceleration: Option<AccelerationStructure>,
-    /// Where the kernel reads texels from (src/texel_windows.rs).
+    /// Where the kernel reads texels from (src/kernel/texels.rs).
     texel_binding: TexelBinding,
 }
 
@@ -200,7 +200,7 @@ impl<'a> GpuRenderer<'a> {
 
     /// [`GpuRenderer::new`]'s kernel with texel bindings of at most `window_bytes` (or the
     /// device's limit, if smaller): tests split small textures over several bindings with it
-    /// (src/texel_windows.rs).
+    /// (src/kernel/texels.rs).
     pub fn with_texel_window(
         ctx: &'a GpuContext,
         scene: &KernelScene,
@@ -260,7 +260,7 @@ impl<'a> GpuRenderer<'a> {
             ),
         };
         let read_only = wgpu::BufferBindingType::Storage { read_only: true };
-        // Texels beyond one binding are split over several (src/texel_windows.rs).
+        // Texels beyond one binding are split over several (src/kernel/texels.rs).
         let limits = device.limits();
         let window_bytes = window_bytes
             .min(limits.max_storage_buffer_binding_size)
@@ -372,7 +372,7 @@ impl<'a> GpuRenderer<'a> {
         );
         let bvh_primitives = storage_buffer(ctx, "BVH primitives", &scene.bvh_primitives);
         let instances = storage_buffer(ctx, "instances", &scene.instances);
-        // Textures are storage buffers in every layout (shaders/texture.wgsl says why).
+        // Textures are storage buffers in every layout (shaders/textures/texture.wgsl says why).
         let textures = storage_buffer(ctx, "textures", &scene.textures);
         let texels: Vec<_> = texel_windows
             .iter()
@@ -402,32 +402,32 @@ impl<'a> GpuRenderer<'a> {
         let environment_alias =
             storage_buffer(ctx, "environment alias table", &scene.environment_alias);
         let lights = storage_buffer(ctx, "lights", &scene.lights);
-        // The PBR material's energy tables (src/ggx_energy.rs), a placeholder without one.
+        // The PBR material's energy tables (src/tables/ggx.rs), a placeholder without one.
         let ggx_energy: &[f32] = if variant.features.pbr {
-            crate::ggx_energy::ggx_energy_table()
+            crate::tables::ggx::ggx_energy_table()
         } else {
             &[]
         };
         let ggx_energy = storage_buffer(ctx, "GGX energy tables", ggx_energy);
-        // The rough dielectric's compensation tables (src/dielectric_energy.rs), a placeholder
+        // The rough dielectric's compensation tables (src/tables/dielectric.rs), a placeholder
         // where no material transmits.
         let dielectric_energy: &[f32] = if variant.features.pbr && variant.features.transmission {
-            crate::dielectric_energy::dielectric_energy_table()
+            crate::tables::dielectric::dielectric_energy_table()
         } else {
             &[]
         };
         let dielectric_energy = storage_buffer(ctx, "dielectric energy tables", dielectric_energy);
-        // The sheen's albedo table (src/sheen_energy.rs), a placeholder without a sheen.
+        // The sheen's albedo table (src/tables/sheen.rs), a placeholder without a sheen.
         let sheen_energy: &[f32] = if variant.features.pbr && variant.features.sheen {
-            crate::sheen_energy::sheen_energy_table()
+            crate::tables::sheen::sheen_energy_table()
         } else {
             &[]
         };
         let sheen_energy = storage_buffer(ctx, "sheen energy table", sheen_energy);
-        // The coat's scaling of the specular lobes below it (src/clearcoat_energy.rs), a
+        // The coat's scaling of the specular lobes below it (src/tables/clearcoat.rs), a
         // placeholder without a coat.
         let clearcoat_energy: &[f32] = if variant.features.pbr && variant.features.clearcoat {
-            crate::clearcoat_energy::clearcoat_energy_table()
+            crate::tables::clearcoat::clearcoat_energy_table()
         } else {
             &[]
         };
@@ -854,7 +854,7 @@ impl Renderer for GpuRenderer<'_> {
     fn add_samples(&mut self, count: u32) -> Result<()> {
         // Dispatches of at most this many samples stay within lavapipe's loop limit. They end
         // at multiples of a power of two of samples, fixed by the scene and the device, so
-        // where the kernel merges (shaders/accumulate.wgsl) never depends on the batching;
+        // where the kernel merges (shaders/integrator/accumulate.wgsl) never depends on the batching;
         // from 64 on those multiples are block ends anyway.
         let per_dispatch = max_samples_per_dispatch(self.loop_iterations, self.loop_limit);
         let step = 1u32 << (31 - per_dispatch.leading_zeros());

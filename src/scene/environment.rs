@@ -1,5 +1,5 @@
 //! The environment map on the host: reading it, and the tables its importance sampling draws
-//! from (WGSL side: `shaders/environment.wgsl`, CPU mirror: `src/cpu/environment.rs`).
+//! from (WGSL side: `shaders/lights/environment.wgsl`, CPU mirror: `src/cpu/lights/environment.rs`).
 //!
 //! # Conventions
 //! The map is equirectangular (latitude-longitude), top row first. A direction d in the map's
@@ -25,7 +25,7 @@
 
 use super::image::{load_linear_image, Encoding, LinearImage};
 use super::limits::MAX_RADIANCE;
-use crate::shader_types::{EnvironmentAlias, EnvironmentTexel};
+use crate::kernel::types::{EnvironmentAlias, EnvironmentTexel};
 use glam::Vec3;
 use std::f64::consts::PI;
 use std::path::Path;

@@ -147,7 +147,7 @@ pub fn decode_linear_image(bytes: &[u8], encoding: Encoding) -> Result<LinearIma
     let decoded = reader
         .decode()
         .map_err(|e| decode_error(e, bytes, format))?;
-    // Alpha is kept for alpha-tested and blended materials (src/cpu/alpha.rs); images without
+    // Alpha is kept for alpha-tested and blended materials (src/cpu/geometry/alpha.rs); images without
     // it are converted without it, so they cost no more memory than before.
     let alpha = if decoded.color().has_alpha() {
         decoded.to_rgba32f().pixels().map(|p| p[3]).collect()

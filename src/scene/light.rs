@@ -1,11 +1,11 @@
 //! Point, spot and directional (sun) lights: the scene's own light type, which a scene file's
 //! `[[lights]]` fills (and which glTF's `KHR_lights_punctual` maps onto one for one), and its
-//! kernel form (`shaders/lights.wgsl`, `src/cpu/lights.rs` sample it).
+//! kernel form (`shaders/lights/sampling.wgsl`, `src/cpu/lights/sampling.rs` sample it).
 //!
 //! Units are radiometric: a point or spot light's `intensity` is a radiant intensity (W/sr), a
 //! directional light's an irradiance (W/m², on a surface facing it). `color` multiplies it.
 
-use crate::shader_types::{self, LIGHT_POINT, LIGHT_SPOT, LIGHT_SUN};
+use crate::kernel::types::{self, LIGHT_POINT, LIGHT_SPOT, LIGHT_SUN};
 use glam::{DVec3, Vec3};
 
 /// A light that is not a surface: a point, a spot or a sun.
@@ -69,7 +69,7 @@ impl Light {
     }
 
     /// Power over π (the π every emitter's power shares is dropped, as in
-    /// `src/scene/kernel.rs`), channels averaged; `scene_radius` sizes a sun's disc of light.
+    /// `src/kernel/scene.rs`), channels averaged; `scene_radius` sizes a sun's disc of light.
     /// A point light radiates 4πI; a spot 2πI·((1 − cos inner) + (cos inner − cos outer)/2),
     /// as pbrt-v4 counts it; a sun E·πR² through the scene's disc, as the environment map does.
     pub fn power(&self, scene_radius: f64) -> f64 {
@@ -91,9 +91,9 @@ impl Light {
 
     /// The kernel's form, with the probability that light sampling picks it. (Point lights
     /// with a radius are spheres in the kernel, not lights: see [`Light::sphere`].)
-    pub fn kernel_light(&self, light_probability: f32) -> shader_types::Light {
+    pub fn kernel_light(&self, light_probability: f32) -> types::Light {
         let emitted = self.emitted();
-        let mut out = shader_types::Light {
+        let mut out = types::Light {
             light_probability,
             emitted: emitted.as_vec3().into(),
             spot_scale: 0.0,

@@ -15,7 +15,7 @@ pub const MIN_LENGTH: f32 = 1e-8;
 
 /// Largest emitted radiance (`emission × strength`, per channel) and background. With the
 /// widest `ior` range, a path's radiance stays below the accumulator's sample bound
-/// (`crate::cpu::accumulate::MAX_SAMPLE`), so a valid scene never loses a sample to it.
+/// (`crate::cpu::integrator::accumulate::MAX_SAMPLE`), so a valid scene never loses a sample to it.
 pub const MAX_RADIANCE: f64 = 1e10;
 
 /// Range of a dielectric's index of refraction: refraction scales radiance by η², at most 1e4.

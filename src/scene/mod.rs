@@ -7,14 +7,9 @@
 //! The parts, in the order data flows: [`file`] is the TOML as written, [`validate`] turns it
 //! into a [`Scene`] or an error, and [`kernel`] lays the scene out for the kernel.
 
-pub mod bvh;
-pub mod bvh_layout;
-pub mod bvh_wide;
-mod emitter_power;
 pub mod environment;
 mod file;
 pub mod image;
-mod kernel;
 pub mod light;
 pub mod limits;
 pub mod mesh;
@@ -24,8 +19,6 @@ pub mod stress;
 pub mod studio;
 pub mod texture;
 mod validate;
-
-pub use kernel::{place_camera, KernelScene};
 
 use crate::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use file::{line_column, SceneToml};
@@ -96,7 +89,7 @@ pub struct Scene {
 }
 
 /// A mesh placed many times and stored once: the two-level structure's bottom level
-/// (src/scene/kernel.rs lays it out, shaders/traverse/blas.wgsl traces it). Its triangles are
+/// (src/kernel/scene.rs lays it out, shaders/traverse/blas.wgsl traces it). Its triangles are
 /// in the mesh file's own coordinates (a glTF primitive's, before its node's transform), and
 /// each placement takes them to the scene's. Only opaque meshes that do not emit and have no
 /// normal map are held so ([`Material::two_level`] says why, `mesh/reuse.rs` which parts);
@@ -215,7 +208,7 @@ pub enum MaterialKind {
     Dielectric {
         ior: f32,
     },
-    /// glTF's metallic-roughness material (`src/cpu/pbr.rs`): a dielectric specular layer over
+    /// glTF's metallic-roughness material (`src/cpu/materials/pbr.rs`): a dielectric specular layer over
     /// a diffuse base, mixed with a conductor by `metallic`.
     Pbr {
         roughness: f32,
@@ -237,7 +230,7 @@ pub enum MaterialKind {
 }
 
 /// KHR_materials_clearcoat's coat and KHR_materials_sheen's sheen on a pbr material
-/// (`src/cpu/clearcoat.rs`, `src/cpu/sheen.rs`); the default has neither. Textures are
+/// (`src/cpu/materials/clearcoat.rs`, `src/cpu/materials/sheen.rs`); the default has neither. Textures are
 /// indices into [`Scene::textures`]: the coat's first channel multiplies `clearcoat`, the
 /// coat roughness's first channel `clearcoat_roughness`, the sheen colour's RGB `sheen_color`,
 /// the sheen roughness's first channel `sheen_roughness`.
@@ -270,12 +263,12 @@ pub struct Material {
     pub roughness_texture: Option<u32>,
     /// Index into [`Scene::textures`] multiplying `emitted_radiance` at each point (glTF's
     /// emissiveTexture; light sampling weighs each triangle by the texture's mean over it,
-    /// `src/scene/emitter_power.rs`).
+    /// `src/kernel/emitters.rs`).
     pub emission_texture: Option<u32>,
     /// Index into [`Scene::textures`] of a tangent-space normal map (glTF's normalTexture),
     /// and the scale of its x and y.
     pub normal_texture: Option<(u32, f32)>,
-    /// glTF's alphaMode and alpha (`src/cpu/alpha.rs`); on triangles only.
+    /// glTF's alphaMode and alpha (`src/cpu/geometry/alpha.rs`); on triangles only.
     pub alpha: Alpha,
 }
 
@@ -291,7 +284,7 @@ impl Material {
     /// Whether a mesh in this material may be stored once and placed by transforms (the
     /// two-level structure, [`InstancedMesh`]), rather than copied per placement. Not when it
     /// emits: light sampling picks emitting triangles by their power in the scene's
-    /// coordinates, one table entry per placed triangle (src/scene/kernel.rs), which an
+    /// coordinates, one table entry per placed triangle (src/kernel/scene.rs), which an
     /// instance would have to sample through its transform. Not when alpha-tested or blended,
     /// nor with a normal map: the alpha test and the tangent frame would need the instance
     /// too. Those are copied as before, which is exact.

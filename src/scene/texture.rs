@@ -1,10 +1,10 @@
 //! The scene's textures on the host: images read once per file (the same file used twice is
-//! loaded once), checked, and laid out as the kernel reads them (`shaders/texture.wgsl`): one
+//! loaded once), checked, and laid out as the kernel reads them (`shaders/textures/texture.wgsl`): one
 //! descriptor per texture and every image's texels in one array, bottom row first, so texture
 //! coordinates (v up) index rows directly.
 
 use super::image::{decode_linear_image, load_linear_image, Encoding, LinearImage};
-use crate::shader_types::{
+use crate::kernel::types::{
     Texture, TEXTURE_CHECKER, TEXTURE_IMAGE, TEXTURE_NEAREST, TEXTURE_WRAP_REPEAT,
 };
 use glam::Vec3;

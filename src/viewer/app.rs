@@ -9,14 +9,13 @@ use super::input::InputState;
 use super::watch::{load_watched, BackgroundLoad, FileWatch, Loaded};
 use super::{ViewOptions, FRAME_TARGET};
 use crate::gpu::{GpuContext, GpuRenderer};
+use crate::image::output::{Image, ImageFormat};
+use crate::image::tonemap::{DisplayTransform, Tonemap};
 use crate::input_file::FileRead;
-use crate::output::{Image, ImageFormat};
+use crate::kernel::types::Params;
+use crate::kernel::{place_camera, KernelScene};
 use crate::render::{BatchSizer, Renderer};
-use crate::scene::{
-    place_camera, Camera, KernelScene, RenderOverrides, Scene, MAX_IMAGE_PIXELS, MAX_SPP,
-};
-use crate::shader_types::Params;
-use crate::tonemap::{DisplayTransform, Tonemap};
+use crate::scene::{Camera, RenderOverrides, Scene, MAX_IMAGE_PIXELS, MAX_SPP};
 use anyhow::{anyhow, Context, Result};
 use serde_json::json;
 use std::path::{Path, PathBuf};

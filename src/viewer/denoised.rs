@@ -1,11 +1,11 @@
-//! The viewer's denoised image (the D key): Open Image Denoise (src/denoise.rs) run on a
+//! The viewer's denoised image (the D key): Open Image Denoise (src/image/denoise.rs) run on a
 //! background thread over a snapshot of the accumulation, so the window stays responsive and
 //! the progressive render goes on meanwhile. [`RefreshSchedule`] decides when to start one and
 //! whether a finished one may be shown; it is pure, so it is tested without a window or OIDN.
 
-use crate::aov::Aovs;
-use crate::denoise::{self, Oidn};
-use crate::output::Image;
+use crate::image::denoise::{self, Oidn};
+use crate::image::output::Image;
+use crate::render::aov::Aovs;
 use crate::render::Renderer;
 use anyhow::Result;
 use std::sync::mpsc;

@@ -1,15 +1,15 @@
 //! The display pass: shows a renderer's running mean (or the denoised image) on a surface,
-//! through the tone curve (`shaders/display.wgsl`, `shaders/tonemap.wgsl`). It reads the mean
+//! through the tone curve (`shaders/viewer/display.wgsl`, `shaders/viewer/tonemap.wgsl`). It reads the mean
 //! buffer where the kernel wrote it, so showing a frame costs no readback.
 
 use crate::gpu::binding::buffer_layout_entry;
-use crate::tonemap::{DisplayTransform, Tonemap};
+use crate::image::tonemap::{DisplayTransform, Tonemap};
 use bytemuck::{Pod, Zeroable};
 
-/// The tone curves (src/tonemap.rs's GPU mirror), then the pass that uses them.
+/// The tone curves (src/image/tonemap.rs's GPU mirror), then the pass that uses them.
 pub const DISPLAY_SHADER: &str = concat!(
-    include_str!("../../shaders/tonemap.wgsl"),
-    include_str!("../../shaders/display.wgsl")
+    include_str!("../../shaders/viewer/tonemap.wgsl"),
+    include_str!("../../shaders/viewer/display.wgsl")
 );
 pub const VERTEX_ENTRY_POINT: &str = "vs_main";
 pub const FRAGMENT_ENTRY_POINT: &str = "fs_main";
@@ -27,7 +27,7 @@ pub struct DisplayUniform {
     pub pad: u32,
 }
 
-/// The shader's code for `tonemap` (`TONEMAP_*` in shaders/tonemap.wgsl).
+/// The shader's code for `tonemap` (`TONEMAP_*` in shaders/viewer/tonemap.wgsl).
 pub fn tonemap_code(tonemap: Tonemap) -> u32 {
     match tonemap {
         Tonemap::Clamp => 0,

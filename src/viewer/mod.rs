@@ -16,10 +16,10 @@ pub mod input;
 pub mod watch;
 
 use crate::error::InputError;
-use crate::output_check::OutputSet;
+use crate::image::output_check::OutputSet;
+use crate::image::tonemap::DisplayTransform;
 use crate::scene::model::ModelOptions;
 use crate::scene::RenderOverrides;
-use crate::tonemap::DisplayTransform;
 use action::Script;
 use anyhow::Result;
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! Alpha on meshes (shaders/alpha.wgsl ↔ src/cpu/alpha.rs): MASK cuts holes where a colour
+//! Alpha on meshes (shaders/geometry/alpha.wgsl ↔ src/cpu/geometry/alpha.rs): MASK cuts holes where a colour
 //! texture's alpha says, for camera and shadow rays; BLEND lets rays through with probability
 //! 1 − α, for camera and shadow rays; on the CPU (through the BVH and the scan) and on the GPU
 //! (through glint's BVH and through ray queries), which trace the same paths.
@@ -6,11 +6,12 @@
 use crate::common;
 
 use common::{gpu, gpu_with_ray_queries, PathAgreement};
-use glint::cpu::renderer::CpuRenderer;
+use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::gpu::{GpuRenderer, Traversal};
-use glint::output::Image;
+use glint::image::output::Image;
+use glint::kernel::KernelScene;
 use glint::render::{render_image, Renderer};
-use glint::scene::{KernelScene, Scene};
+use glint::scene::Scene;
 use std::f32::consts::PI;
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! The denoiser's AOVs (shaders/aov.wgsl, src/cpu/aov.rs): a diffuse wall's albedo is exactly its
+//! The denoiser's AOVs (shaders/integrator/aov.wgsl, src/cpu/integrator/aov.rs): a diffuse wall's albedo is exactly its
 //! colour and its normal exactly the quad's; a mirror facing the camera shows the wall behind it;
 //! the background and emitters give their clamped radiance; GPU and CPU record the same AOVs;
 //! accumulating them leaves the image bit for bit unchanged. And the firefly clamp: it bounds
@@ -6,11 +6,11 @@
 
 use crate::common;
 use common::{gpu, kernel_scene, PathAgreement};
-use glint::aov::{Aovs, BACKGROUND_DEPTH};
 use glint::gpu::GpuRenderer;
-use glint::output::Image;
+use glint::image::output::Image;
+use glint::kernel::KernelScene;
+use glint::render::aov::{Aovs, BACKGROUND_DEPTH};
 use glint::render::render_image;
-use glint::scene::KernelScene;
 
 /// Renders `spp` samples in batches of `batch` with AOVs on, on the CPU and (where there is
 /// one) the GPU: (device, mean, AOVs).
@@ -191,8 +191,8 @@ fn aovs_do_not_change_the_image() {
         assert!(a == b, "{device}: AOVs changed the image");
     }
     if let Some(ctx) = gpu() {
-        let variant = glint::shader::KernelVariant {
-            features: glint::shader::KernelFeatures::ALL,
+        let variant = glint::kernel::variant::KernelVariant {
+            features: glint::kernel::variant::KernelFeatures::ALL,
             ..GpuRenderer::new(ctx, &scene).unwrap().variant()
         };
         let mut all = GpuRenderer::with_variant(ctx, &scene, variant).unwrap();

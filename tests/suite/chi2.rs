@@ -13,8 +13,8 @@ use common::chi2::{
 };
 use common::probe::{run_probe, ProbeParams};
 use glam::Vec3;
-use glint::cpu::diffuse::sample_cosine_hemisphere;
-use glint::cpu::rng::Rng;
+use glint::cpu::core::rng::Rng;
+use glint::cpu::materials::diffuse::sample_cosine_hemisphere;
 use std::f64::consts::PI;
 
 const SAMPLES: u32 = 1_000_000;
@@ -40,7 +40,7 @@ fn probe(normal: Vec3, count: u32, seed: u32) -> ProbeParams {
 }
 
 /// A scene for probes that read none of it.
-fn empty_scene() -> glint::scene::KernelScene {
+fn empty_scene() -> glint::kernel::KernelScene {
     common::kernel_scene(SCENE_HEADER)
 }
 
@@ -363,11 +363,11 @@ fn check_light_samples(name: &str, scene: &glint::scene::Scene, p: Vec3, samples
 fn cpu_light_sampling() {
     for (k, (name, scene, p)) in light_cases().into_iter().enumerate() {
         let kernel = scene.kernel_scene();
-        let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
+        let refs = glint::cpu::integrator::trace::SceneRefs::of(&kernel, &kernel.params);
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 21 + k as u32);
-                let s = glint::cpu::lights::sample_light(&refs, p, p, &mut r);
+                let s = glint::cpu::lights::sampling::sample_light(&refs, p, p, &mut r);
                 [s.dir.x, s.dir.y, s.dir.z, s.pdf]
             })
             .collect();
@@ -431,7 +431,7 @@ fn many_emitters() -> glint::scene::Scene {
 /// Each emitter (primitive, index) with the probability of picking it, power / total power,
 /// computed here in f64 from the scene alone.
 fn reference_emitter_probabilities(scene: &glint::scene::Scene) -> Vec<((u32, u32), f64)> {
-    use glint::shader_types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE};
+    use glint::kernel::types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE};
     let power = |material: u32| {
         scene.materials[material as usize]
             .emitted_radiance
@@ -462,7 +462,7 @@ fn reference_emitter_probabilities(scene: &glint::scene::Scene) -> Vec<((u32, u3
 /// and every reported probability must be, exactly, the one light_pdf uses for that emitter
 /// (the primitive's `light_probability`), so MIS stays consistent with the pick.
 fn check_emitter_choices(name: &str, scene: &glint::scene::Scene, picks: &[[f32; 4]]) {
-    use glint::shader_types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE};
+    use glint::kernel::types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE};
     let kernel = scene.kernel_scene();
     let reference = reference_emitter_probabilities(scene);
     let ordinal: std::collections::HashMap<(u32, u32), usize> = reference
@@ -492,13 +492,13 @@ fn check_emitter_choices(name: &str, scene: &glint::scene::Scene, picks: &[[f32;
     assert_fits(name, &Ok(pearson(&observed, &expected)));
 }
 
-fn cpu_emitter_choices(scene: &glint::scene::KernelScene, seed: u32) -> Vec<[f32; 4]> {
-    let refs = glint::cpu::trace::SceneRefs::of(scene, &scene.params);
+fn cpu_emitter_choices(scene: &glint::kernel::KernelScene, seed: u32) -> Vec<[f32; 4]> {
+    let refs = glint::cpu::integrator::trace::SceneRefs::of(scene, &scene.params);
     (0..SAMPLES)
         .map(|i| {
             let mut r = cpu_draws(i, seed);
             let (u_slot, u_alias) = (r.next_f32(), r.next_f32());
-            let e = glint::cpu::lights::pick_emitter(&refs, u_slot, u_alias);
+            let e = glint::cpu::lights::sampling::pick_emitter(&refs, u_slot, u_alias);
             [e.primitive as f32, e.index as f32, e.probability, 0.0]
         })
         .collect()
@@ -598,16 +598,16 @@ fn check_metal_samples(name: &str, n: Vec3, wo: Vec3, alpha: f32, samples: &[[f3
 #[test]
 fn cpu_metal_sampling() {
     for (k, (name, n, wo, alpha)) in metal_cases().into_iter().enumerate() {
-        let m = glint::shader_types::Material {
+        let m = glint::kernel::types::Material {
             albedo: [1.0; 3],
-            kind: glint::shader_types::MATERIAL_METAL,
+            kind: glint::kernel::types::MATERIAL_METAL,
             alpha,
             ..Default::default()
         };
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 41 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&m, wo, n, n, true, &mut r);
+                let s = glint::cpu::materials::material::bsdf_sample(&m, wo, n, n, true, &mut r);
                 [s.dir.x, s.dir.y, s.dir.z, s.weight.x]
             })
             .collect();
@@ -707,11 +707,11 @@ fn dielectric_geometry(degrees: f32) -> (Vec3, Vec3) {
     (n, (theta.cos() * n + theta.sin() * t).normalize())
 }
 
-fn glass(front_face: bool) -> glint::shader_types::Material {
+fn glass(front_face: bool) -> glint::kernel::types::Material {
     let _ = front_face;
-    glint::shader_types::Material {
+    glint::kernel::types::Material {
         albedo: [1.0; 3],
-        kind: glint::shader_types::MATERIAL_DIELECTRIC,
+        kind: glint::kernel::types::MATERIAL_DIELECTRIC,
         ior: GLASS_IOR,
         ..Default::default()
     }
@@ -724,7 +724,14 @@ fn cpu_dielectric_choice() {
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 81 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&glass(front), wo, n, n, front, &mut r);
+                let s = glint::cpu::materials::material::bsdf_sample(
+                    &glass(front),
+                    wo,
+                    n,
+                    n,
+                    front,
+                    &mut r,
+                );
                 [s.dir.x, s.dir.y, s.dir.z, s.weight.x]
             })
             .collect();
@@ -769,7 +776,8 @@ fn total_internal_reflection_always_reflects() {
     let (n, wo) = dielectric_geometry(60.0);
     for i in 0..100_000 {
         let mut r = cpu_draws(i, SEED);
-        let s = glint::cpu::material::bsdf_sample(&glass(false), wo, n, n, false, &mut r);
+        let s =
+            glint::cpu::materials::material::bsdf_sample(&glass(false), wo, n, n, false, &mut r);
         assert!(s.dir.dot(n) > 0.0, "refracted beyond the critical angle");
         assert_eq!(s.weight, Vec3::ONE);
     }
@@ -940,11 +948,16 @@ fn cpu_environment_sampling() {
     let dir = tempfile::tempdir().unwrap();
     for (k, case) in map_cases().iter().enumerate() {
         let kernel = environment_scene(case, dir.path()).kernel_scene();
-        let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
+        let refs = glint::cpu::integrator::trace::SceneRefs::of(&kernel, &kernel.params);
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 101 + k as u32);
-                let s = glint::cpu::lights::sample_light(&refs, Vec3::ZERO, Vec3::ZERO, &mut r);
+                let s = glint::cpu::lights::sampling::sample_light(
+                    &refs,
+                    Vec3::ZERO,
+                    Vec3::ZERO,
+                    &mut r,
+                );
                 [s.dir.x, s.dir.y, s.dir.z, s.pdf]
             })
             .collect();
@@ -1021,11 +1034,12 @@ fn check_sun_samples(name: &str, samples: &[[f32; 4]]) {
 #[test]
 fn cpu_sun_disk_sampling() {
     let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
-    let refs = glint::cpu::trace::SceneRefs::of(&kernel, &kernel.params);
+    let refs = glint::cpu::integrator::trace::SceneRefs::of(&kernel, &kernel.params);
     let samples: Vec<[f32; 4]> = (0..SAMPLES)
         .map(|i| {
             let mut r = cpu_draws(i, SEED + 51);
-            let s = glint::cpu::lights::sample_light(&refs, Vec3::ZERO, Vec3::ZERO, &mut r);
+            let s =
+                glint::cpu::lights::sampling::sample_light(&refs, Vec3::ZERO, Vec3::ZERO, &mut r);
             [s.dir.x, s.dir.y, s.dir.z, s.pdf]
         })
         .collect();
@@ -1053,9 +1067,9 @@ fn gpu_sun_disk_sampling() {
 fn cpu_pbr_sampling() {
     for (k, (name, n, wo, alpha)) in metal_cases().into_iter().enumerate() {
         for metallic in [0.0f32, 1.0] {
-            let m = glint::shader_types::Material {
+            let m = glint::kernel::types::Material {
                 albedo: [0.8, 0.5, 0.3],
-                kind: glint::shader_types::MATERIAL_PBR,
+                kind: glint::kernel::types::MATERIAL_PBR,
                 alpha,
                 ior: 1.5,
                 metallic,
@@ -1063,13 +1077,14 @@ fn cpu_pbr_sampling() {
                 specular_color: [1.0; 3],
                 ..Default::default()
             };
-            let p = glint::cpu::pbr::pbr_lobes(&m, wo.dot(n), wo.dot(n), true)
+            let p = glint::cpu::materials::pbr::pbr_lobes(&m, wo.dot(n), wo.dot(n), true)
                 .specular_probability() as f64;
             let dirs: Vec<Vec3> = (0..SAMPLES)
                 .map(|i| {
                     let mut r = cpu_draws(i, SEED + 97 + k as u32);
-                    let s = glint::cpu::material::bsdf_sample(&m, wo, n, n, true, &mut r);
-                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, n, true);
+                    let s =
+                        glint::cpu::materials::material::bsdf_sample(&m, wo, n, n, true, &mut r);
+                    let pdf = glint::cpu::materials::material::bsdf_pdf(&m, wo, s.dir, n, n, true);
                     let above = s.dir.dot(n) > 0.0;
                     assert_eq!(
                         s.weight == Vec3::ZERO,
@@ -1154,7 +1169,7 @@ fn reference_rough_dielectric_pdf(
 
 /// The compensated rough dielectric's density: the single-scattering reference above with the
 /// probability the sampler gives it, else a cosine lobe below (probability t) or above, with
-/// the shares the code's tables give (src/cpu/rough_dielectric.rs says how they are chosen).
+/// the shares the code's tables give (src/cpu/materials/rough_dielectric.rs says how they are chosen).
 fn reference_compensated_pdf(
     wo: glam::DVec3,
     wi: glam::DVec3,
@@ -1167,11 +1182,12 @@ fn reference_compensated_pdf(
     if cos_o <= 0.0 || cos_i == 0.0 {
         return 0.0;
     }
-    let (single, transmitted) = glint::cpu::rough_dielectric::rough_dielectric_lobe_shares(
-        alpha as f32,
-        (eta_i / eta_o) as f32,
-        cos_o as f32,
-    );
+    let (single, transmitted) =
+        glint::cpu::materials::rough_dielectric::rough_dielectric_lobe_shares(
+            alpha as f32,
+            (eta_i / eta_o) as f32,
+            cos_o as f32,
+        );
     let (single, transmitted) = (single as f64, transmitted as f64);
     let share = if cos_i > 0.0 {
         1.0 - transmitted
@@ -1218,7 +1234,7 @@ fn cpu_rough_dielectric_sampling() {
                 .map(|i| {
                     let mut r = cpu_draws(i, SEED + 131 + (3 * k + c) as u32);
                     let u = (r.next_f32(), r.next_f32());
-                    let s = glint::cpu::rough_dielectric::rough_dielectric_sample(
+                    let s = glint::cpu::materials::rough_dielectric::rough_dielectric_sample(
                         alpha,
                         etap,
                         wo,
@@ -1241,7 +1257,9 @@ fn cpu_rough_dielectric_sampling() {
             };
             // The kept samples' pdf as the code computes it matches the reference.
             for d in kept.iter().take(2000) {
-                let mine = glint::cpu::rough_dielectric::rough_dielectric_pdf(alpha, etap, wo, *d);
+                let mine = glint::cpu::materials::rough_dielectric::rough_dielectric_pdf(
+                    alpha, etap, wo, *d,
+                );
                 let want = pdf(*d);
                 assert!(
                     ((mine as f64) - want).abs() <= 2e-3 * want + 1e-6,
@@ -1277,10 +1295,10 @@ fn pbr_transmission_geometry() -> (Vec3, Vec3) {
     (n, 0.5 * n + 0.75f32.sqrt() * t)
 }
 
-fn pbr_glass(albedo: [f32; 3], alpha: f32, transmission: f32) -> glint::shader_types::Material {
-    glint::shader_types::Material {
+fn pbr_glass(albedo: [f32; 3], alpha: f32, transmission: f32) -> glint::kernel::types::Material {
+    glint::kernel::types::Material {
         albedo,
-        kind: glint::shader_types::MATERIAL_PBR,
+        kind: glint::kernel::types::MATERIAL_PBR,
         alpha,
         ior: GLASS_IOR,
         metallic: 0.0,
@@ -1298,12 +1316,12 @@ fn pbr_glass(albedo: [f32; 3], alpha: f32, transmission: f32) -> glint::shader_t
 /// (reflections below the surface, refractions above it) are absorbed.
 fn check_pbr_transmission_samples(
     name: &str,
-    m: &glint::shader_types::Material,
+    m: &glint::kernel::types::Material,
     entering: bool,
     samples: &[(Vec3, bool)],
 ) {
     let (n, wo) = pbr_transmission_geometry();
-    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), wo.dot(n), entering);
+    let lobes = glint::cpu::materials::pbr::pbr_lobes(m, wo.dot(n), wo.dot(n), entering);
     let p_s = lobes.specular_probability() as f64;
     let p_t = lobes.transmission_probability() as f64;
     if m.transmission == 1.0 {
@@ -1345,7 +1363,8 @@ fn cpu_pbr_transmission_sampling() {
         let samples: Vec<(Vec3, bool)> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 151 + k as u32);
-                let s = glint::cpu::material::bsdf_sample(&m, wo, n, n, entering, &mut r);
+                let s =
+                    glint::cpu::materials::material::bsdf_sample(&m, wo, n, n, entering, &mut r);
                 let kept = s.weight != Vec3::ZERO;
                 if kept {
                     // Refraction is marked delta (light sampling cannot reach it).
@@ -1401,8 +1420,8 @@ fn pbr_layered(
     sheen: f32,
     sheen_roughness: f32,
     alpha: f32,
-) -> glint::shader_types::Material {
-    glint::shader_types::Material {
+) -> glint::kernel::types::Material {
+    glint::kernel::types::Material {
         clearcoat,
         clearcoat_alpha: coat_alpha,
         sheen_color: [sheen; 3],
@@ -1417,12 +1436,12 @@ fn pbr_layered(
 /// above.
 fn check_pbr_layer_samples(
     name: &str,
-    m: &glint::shader_types::Material,
+    m: &glint::kernel::types::Material,
     coat_n: Vec3,
     dirs: &[Vec3],
 ) {
     let (n, wo) = pbr_transmission_geometry();
-    let lobes = glint::cpu::pbr::pbr_lobes(m, wo.dot(n), wo.dot(coat_n), true);
+    let lobes = glint::cpu::materials::pbr::pbr_lobes(m, wo.dot(n), wo.dot(coat_n), true);
     let p_s = lobes.specular_probability() as f64;
     let p_c = lobes.coat_probability() as f64;
     let p_h = lobes.sheen_probability() as f64;
@@ -1477,8 +1496,11 @@ fn cpu_pbr_layer_sampling() {
             let dirs: Vec<Vec3> = (0..SAMPLES)
                 .map(|i| {
                     let mut r = cpu_draws(i, SEED + 191 + k as u32);
-                    let s = glint::cpu::material::bsdf_sample(&m, wo, n, coat_n, true, &mut r);
-                    let pdf = glint::cpu::material::bsdf_pdf(&m, wo, s.dir, n, coat_n, true);
+                    let s = glint::cpu::materials::material::bsdf_sample(
+                        &m, wo, n, coat_n, true, &mut r,
+                    );
+                    let pdf =
+                        glint::cpu::materials::material::bsdf_pdf(&m, wo, s.dir, n, coat_n, true);
                     // The coat's α 0.01 lobe turns the direction's f32 rounding between frames
                     // into relative pdf differences near 1e-3.
                     if s.dir.dot(n) > 0.0 {

@@ -9,9 +9,10 @@ use crate::common;
 
 use base64::Engine as _;
 use common::{render_with_variance, PathAgreement};
-use glint::cpu::renderer::CpuRenderer;
-use glint::scene::{KernelScene, MaterialKind, Scene};
-use glint::shader_types::NO_TEXTURE;
+use glint::cpu::integrator::renderer::CpuRenderer;
+use glint::kernel::types::NO_TEXTURE;
+use glint::kernel::KernelScene;
+use glint::scene::{MaterialKind, Scene};
 
 /// A normal-map texel tilted 37° towards +x (the tangent, increasing u).
 const TILTED: [u8; 3] = [204, 128, 230];

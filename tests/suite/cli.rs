@@ -3,7 +3,7 @@
 //! twice writes byte-identical EXR and PNG files.
 
 use crate::common;
-use glint::output::Image;
+use glint::image::output::Image;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

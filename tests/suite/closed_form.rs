@@ -107,7 +107,7 @@ radius = R
 material = "white"
 "#;
 
-fn white_sphere(center: [f32; 3], radius: f32, bounces: u32) -> glint::scene::KernelScene {
+fn white_sphere(center: [f32; 3], radius: f32, bounces: u32) -> glint::kernel::KernelScene {
     let eye = [center[0], center[1], center[2] - 4.0 * radius];
     let mut text = WHITE_SPHERE
         .replace("BOUNCES", &bounces.to_string())
@@ -195,7 +195,7 @@ fn floor_under_an_emitting_sphere_matches_the_irradiance_formula() {
 }
 
 /// A sphere of `material` under a uniform white sky, seen by a camera outside it.
-fn white_furnace(material: &str) -> glint::scene::KernelScene {
+fn white_furnace(material: &str) -> glint::kernel::KernelScene {
     kernel_scene(&format!(
         r#"
 [camera]
@@ -313,7 +313,7 @@ material = "m"
             ez = -10.0 * tilt.cos(),
         ));
         let expected = ggx_albedo_quadrature(tilt.cos(), roughness * roughness);
-        let mut renderer = glint::cpu::renderer::CpuRenderer::new(&scene);
+        let mut renderer = glint::cpu::integrator::renderer::CpuRenderer::new(&scene);
         use glint::render::Renderer;
         renderer.add_samples(256).unwrap();
         let mean = renderer.read_mean().unwrap().mean();

@@ -1,4 +1,4 @@
-//! The closest-hit rule (`hit_comes_first` in src/cpu/intersect.rs and shaders/intersect.wgsl):
+//! The closest-hit rule (`hit_comes_first` in src/cpu/geometry/intersect.rs and shaders/geometry/intersect.wgsl):
 //! the smallest t, then the lowest primitive reference (spheres, quads, triangles, each by index),
 //! whatever the structure. On 10⁵ rays per scene, the scan, the binary and 4-wide BVHs (with and
 //! without every coincident copy) and the hardware traversal find the same hit, t and primitive
@@ -9,16 +9,18 @@ use crate::common;
 use common::probe::{run_probe_bvh, run_probe_bvh_wide, run_probe_hardware, ProbeParams};
 use common::{gpu, gpu_with_ray_queries};
 use glam::Vec3;
-use glint::cpu::intersect::{
+use glint::cpu::core::ray::Ray;
+use glint::cpu::core::rng::Rng;
+use glint::cpu::geometry::intersect::{
     closest_primitive, escapes, first_hit_is, scan_closest_primitive, ClosestPrimitive, Geometry,
     NO_HIT,
 };
-use glint::cpu::rng::Rng;
-use glint::cpu::trace::SceneRefs;
-use glint::cpu::Ray;
+use glint::cpu::integrator::trace::SceneRefs;
+use glint::kernel::bvh;
+use glint::kernel::types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE};
+use glint::kernel::KernelScene;
 use glint::scene::stress::StressMesh;
-use glint::scene::{bvh, KernelScene, Scene};
-use glint::shader_types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE};
+use glint::scene::Scene;
 
 const HEADER: &str = r#"
 [camera]
@@ -65,7 +67,7 @@ fn copies_scene(dir: &std::path::Path) -> KernelScene {
 }
 
 /// [`copies_scene`]'s file, its cube's copies flattened (`[[meshes]]` entries) or, without
-/// `flattened`, one entry's 20 coincident instances in white (stored once, src/scene/kernel.rs).
+/// `flattened`, one entry's 20 coincident instances in white (stored once, src/kernel/scene.rs).
 fn copies_toml(dir: &std::path::Path, flattened: bool) -> String {
     std::fs::write(dir.join("cube.obj"), CUBE_OBJ).unwrap();
     StressMesh::new(24, 12)
@@ -280,7 +282,7 @@ const GPU_RAYS: u32 = 25_000;
 /// The GPU traversals [`check_gpu`] runs.
 #[derive(Clone, Copy, Debug)]
 enum GpuTraversal {
-    /// The binary BVH (shaders/bvh.wgsl).
+    /// The binary BVH (shaders/traverse/bvh.wgsl).
     Binary,
     /// The 4-wide BVH (shaders/traverse/wide.wgsl).
     Wide,

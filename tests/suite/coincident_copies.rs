@@ -7,8 +7,10 @@
 use crate::common;
 use common::{gpu, gpu_with_ray_queries, render_cpu, render_gpu, shipped_scene_text, sized};
 use glint::gpu::{GpuRenderer, Traversal};
+use glint::kernel::bvh;
+use glint::kernel::KernelScene;
 use glint::render::render_image;
-use glint::scene::{bvh, KernelScene, Scene};
+use glint::scene::Scene;
 use std::path::Path;
 
 /// A block on the floor, clear of both spheres: its 6 faces.
@@ -81,7 +83,7 @@ fn cornell_with_block(copies: bool, size: u32, seed: u32) -> KernelScene {
 fn with_copies_in_the_tree(scene: &KernelScene) -> KernelScene {
     let tree = bvh::build_with_copies(&scene.spheres, &scene.quads, &scene.triangles).unwrap();
     assert!(
-        tree.depth <= glint::cpu::bvh::BVH_STACK_SIZE,
+        tree.depth <= glint::cpu::traverse::bvh::BVH_STACK_SIZE,
         "{}",
         tree.depth
     );

@@ -5,10 +5,10 @@
 //! scripts/test, which installs it). GLINT_WRITE_DOCS=1 rewrites the docs' images (docs/*.png).
 
 use crate::common;
-use glint::compare::compare;
-use glint::denoise::Oidn;
 use glint::gpu::GpuRenderer;
-use glint::output::Image;
+use glint::image::compare::compare;
+use glint::image::denoise::Oidn;
+use glint::image::output::Image;
 use glint::render::{render_image, Renderer};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -17,7 +17,7 @@ use std::process::{Command, Output};
 const GLINT: &str = env!("CARGO_BIN_EXE_glint");
 
 fn oidn() -> Option<&'static Oidn> {
-    match glint::denoise::oidn() {
+    match glint::image::denoise::oidn() {
         Ok(oidn) => Some(oidn),
         Err(e) if std::env::var_os("GLINT_REQUIRE_OIDN").is_some() => {
             panic!("GLINT_REQUIRE_OIDN is set: {e}")

@@ -7,7 +7,7 @@
 #![allow(clippy::single_range_in_vec_init)]
 
 use crate::common;
-use glint::partial::Partial;
+use glint::render::partial::Partial;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;

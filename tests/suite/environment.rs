@@ -8,11 +8,12 @@
 
 use crate::common;
 use common::{largest_deviation, render_both, with_light_sampling, write_map, PathAgreement};
-use glint::compare::compare;
-use glint::cpu::renderer::CpuRenderer;
-use glint::output::Image;
+use glint::cpu::integrator::renderer::CpuRenderer;
+use glint::image::compare::compare;
+use glint::image::output::Image;
+use glint::kernel::KernelScene;
 use glint::render::render_image;
-use glint::scene::{KernelScene, Scene};
+use glint::scene::Scene;
 use std::path::Path;
 
 /// A scene file's text: `camera`, `render` lines, then `rest`, in `dir` as scene.toml.
@@ -70,7 +71,7 @@ material = "floor"
 /// A constant map lights the scene exactly as the same constant background does; with light
 /// sampling the map is also sampled as an emitter (MIS with the BSDF), so the two agree in
 /// expectation, not sample by sample. The per-pixel Z-test and the z of the image means
-/// (glint::compare, variances from both renders' variance images) catch any bias; |z| < 5 for
+/// (glint::image::compare, variances from both renders' variance images) catch any bias; |z| < 5 for
 /// the means fails wrongly with probability 6·10⁻⁷, and a 1% Z-test passes ≥ 97% of pixel
 /// channels unless something is wrong (its expected rate is 99%, with a standard deviation of
 /// 0.4% over 3·24² channels).
@@ -267,7 +268,7 @@ fn gpu_and_cpu_trace_the_same_paths_under_a_map() {
     agreement.check(0.97);
 }
 
-/// Relative MSE (glint::compare's, against a 1024-spp light-sampled reference) of 16-spp
+/// Relative MSE (glint::image::compare's, against a 1024-spp light-sampled reference) of 16-spp
 /// renders of a diffuse scene under the shipped sky with its small sun, averaged over four
 /// seeds: importance sampling the map must lower it at least tenfold against BSDF sampling
 /// alone, as the issue asks. (Measured: about 200×; the sun is 2·10⁻³ sr, so BSDF sampling

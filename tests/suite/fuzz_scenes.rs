@@ -23,8 +23,8 @@
 //! the mutated scene. `GLINT_FUZZ_SEED` and `GLINT_FUZZ_CASES` (a multiplier) run other or
 //! more cases by hand.
 
-use glint::cpu::renderer::CpuRenderer;
-use glint::output::Image;
+use glint::cpu::integrator::renderer::CpuRenderer;
+use glint::image::output::Image;
 use glint::render::Renderer;
 use glint::scene::{RenderOverrides, Scene};
 use std::path::Path;

@@ -397,7 +397,7 @@ fn textured_glb() -> Vec<u8> {
 /// products are the same f32 operations on both sides, so they agree to an ulp or two).
 #[test]
 fn embedded_textures_multiply_their_factors_on_both_devices() {
-    use glint::cpu::texture::{both_sets, material_at, Textures};
+    use glint::cpu::textures::texture::{both_sets, material_at, Textures};
     let scene = load_glb(&textured_glb()).unwrap_or_else(|e| panic!("{e}"));
     let index = scene.triangles[0].material;
     let scene = scene.kernel_scene();
@@ -450,7 +450,7 @@ fn embedded_textures_multiply_their_factors_on_both_devices() {
     let mut probed = scene.clone();
     probed.triangle_uvs = centres
         .iter()
-        .map(|(_, uv)| glint::shader_types::TriangleUvs {
+        .map(|(_, uv)| glint::kernel::types::TriangleUvs {
             uv0: uv.to_array(),
             ..Default::default()
         })
@@ -541,7 +541,7 @@ fn a_texture_on_the_third_coordinate_set_is_a_warning() {
 /// in 32² pixels, black behind it, no scattering: a pixel is what the square emits. Its
 /// emissive texture (COLOR_TEXELS, nearest) is on TEXCOORD_1, which lays the image over the
 /// square upright; TEXCOORD_0 puts every vertex on one texel (the top left).
-fn texcoord1_square(dir: &std::path::Path) -> glint::scene::KernelScene {
+fn texcoord1_square(dir: &std::path::Path) -> glint::kernel::KernelScene {
     use base64::Engine as _;
     let corners = [[-1.0f32, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
     let mut bin: Vec<u8> = Vec::new();
@@ -617,14 +617,14 @@ fn texcoord1_square(dir: &std::path::Path) -> glint::scene::KernelScene {
 /// agree.
 #[test]
 fn a_texture_on_texcoord_1_reads_the_second_set_on_both_devices() {
-    use glint::cpu::renderer::CpuRenderer;
+    use glint::cpu::integrator::renderer::CpuRenderer;
     use glint::gpu::{GpuRenderer, Traversal};
     use glint::render::render_image;
     let dir = tempfile::tempdir().unwrap();
     let scene = texcoord1_square(dir.path());
     let texture = scene.textures[scene.materials[0].emission_texture as usize];
     assert_eq!(texture.uv_set, 1);
-    assert!(glint::shader::KernelFeatures::of(&scene).texcoord1);
+    assert!(glint::kernel::variant::KernelFeatures::of(&scene).texcoord1);
     assert_eq!(scene.triangle_uvs1.len(), 2);
     assert_eq!(scene.triangle_uvs1[0].uv1, [1.0, 0.0]);
     assert_eq!(scene.triangle_uvs[0].uv1, [0.1, 0.9]);
@@ -673,7 +673,7 @@ fn a_texture_on_texcoord_1_reads_the_second_set_on_both_devices() {
 /// checks, tests/suite/gltf_samples.rs) gives for glTF's (u, 1 − v), with v flipped back.
 #[test]
 fn samplers_and_texture_transforms_reach_the_descriptor() {
-    use glint::shader_types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
+    use glint::kernel::types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
     let (offset, rotation, scale) = ([0.25f32, -0.5], 0.5f32, [2.0f32, 3.0]);
     let material = serde_json::json!({"pbrMetallicRoughness": {
         "baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
@@ -703,7 +703,7 @@ fn samplers_and_texture_transforms_reach_the_descriptor() {
     for uv in [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0], [0.3, 0.7]] {
         let gltf = matrix * Vec3::new(uv[0], 1.0 - uv[1], 1.0);
         let want = glam::Vec2::new(gltf.x, 1.0 - gltf.y);
-        let got = glint::cpu::texture::transformed_uv(&t, glam::Vec2::from(uv));
+        let got = glint::cpu::textures::texture::transformed_uv(&t, glam::Vec2::from(uv));
         assert!(
             (got - want).abs().max_element() < 1e-5,
             "at {uv:?}: {got} against {want}"
@@ -729,8 +729,8 @@ fn an_unknown_wrap_mode_is_an_error() {
 /// material's alpha, and reach the kernel's material as its mode, opacity and cutoff.
 #[test]
 fn alpha_mode_cutoff_and_opacity_map_onto_the_material() {
+    use glint::kernel::types::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
     use glint::scene::{Alpha, AlphaMode};
-    use glint::shader_types::{ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE};
     for (material, want, kernel) in [
         (serde_json::json!({}), Alpha::OPAQUE, (ALPHA_OPAQUE, 0.5)),
         (
@@ -836,7 +836,7 @@ fn rgba_png(texels: [[u8; 4]; 4]) -> Vec<u8> {
 /// colour is sRGB-decoded as before. An RGB texture's alpha is 1.
 #[test]
 fn the_base_color_textures_alpha_is_kept_linear() {
-    use glint::cpu::texture::{both_sets, texture_alpha, Textures};
+    use glint::cpu::textures::texture::{both_sets, texture_alpha, Textures};
     let texels = [
         [255, 0, 0, 0],
         [0, 255, 0, 64],

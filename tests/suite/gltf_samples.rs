@@ -5,7 +5,7 @@
 use crate::common;
 
 use glam::{Mat3, Vec2, Vec3};
-use glint::output::Image;
+use glint::image::output::Image;
 use glint::scene::Scene;
 use std::path::{Path, PathBuf};
 
@@ -374,7 +374,7 @@ fn the_damaged_helmet_glows_only_where_its_emissive_map_says() {
 }
 
 /// The helmet's five 2048² maps take 256 MiB as texels, twice lavapipe's 128 MiB storage
-/// binding: the GPU splits them over bindings (src/texel_windows.rs) and traces the CPU's
+/// binding: the GPU splits them over bindings (src/kernel/texels.rs) and traces the CPU's
 /// paths, by the criterion of tests/suite/gpu_vs_cpu.rs, at 64² under the environment map: four
 /// seeds at one path per pixel (four samples per pixel in all).
 #[test]
@@ -447,7 +447,7 @@ fn the_clear_coat_test_loads_and_renders() {
         .materials
         .iter()
         .filter(|m| {
-            m.clearcoat > 0.0 && m.clearcoat_normal_texture != glint::shader_types::NO_TEXTURE
+            m.clearcoat > 0.0 && m.clearcoat_normal_texture != glint::kernel::types::NO_TEXTURE
         })
         .count();
     assert!(coat_mapped >= 1, "no material has the coat's normal map");

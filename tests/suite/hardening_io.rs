@@ -3,7 +3,7 @@
 //! closed stdout and stderr, outputs that collide or overwrite an input, permissions and links
 //! kept, FIFOs, /dev/zero and oversized scenes, unwritable outputs, `compare` on PNGs and NaNs.
 
-use glint::output::Image;
+use glint::image::output::Image;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -502,13 +502,14 @@ fn item14_a_full_disk_says_so_not_decoding() {
         pixels: vec![[0.5; 3]; 64 * 64],
     };
     for format in [
-        glint::output::ImageFormat::Exr,
-        glint::output::ImageFormat::Png,
+        glint::image::output::ImageFormat::Exr,
+        glint::image::output::ImageFormat::Png,
     ] {
-        let e =
-            glint::atomic_write::encode_into(&full, Path::new("x"), |w| image.encode(format, w))
-                .unwrap_err()
-                .to_string();
+        let e = glint::image::atomic_write::encode_into(&full, Path::new("x"), |w| {
+            image.encode(format, w)
+        })
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("No space left on device"), "{format:?}: {e}");
         assert!(!e.contains("ecoding"), "{format:?}: {e}");
     }

@@ -8,17 +8,18 @@
 use crate::common;
 use common::{gpu, kernel_scene, render_cpu, PathAgreement};
 use glam::Vec3;
-use glint::cpu::intersect::{first_hit_is, intersect_scene, Geometry, NO_HIT};
-use glint::cpu::lights::power_heuristic;
-use glint::cpu::renderer::CpuRenderer;
-use glint::cpu::surface::offset_ray_origin;
-use glint::cpu::Ray;
+use glint::cpu::core::ray::Ray;
+use glint::cpu::geometry::intersect::{first_hit_is, intersect_scene, Geometry, NO_HIT};
+use glint::cpu::geometry::surface::offset_ray_origin;
+use glint::cpu::integrator::renderer::CpuRenderer;
+use glint::cpu::lights::sampling::power_heuristic;
 use glint::error::InputError;
 use glint::gpu::GpuRenderer;
-use glint::output::{Image, NAN_PIXEL};
+use glint::image::output::{Image, NAN_PIXEL};
+use glint::kernel::types::PRIMITIVE_QUAD;
+use glint::kernel::KernelScene;
 use glint::render::{render_image, Renderer};
-use glint::scene::{KernelScene, Scene, SceneError};
-use glint::shader_types::PRIMITIVE_QUAD;
+use glint::scene::{Scene, SceneError};
 use std::path::Path;
 
 /// A small valid scene: a grey floor quad under a lamp quad, a sphere, seen from above.
@@ -440,7 +441,7 @@ fn a_scene_beyond_the_devices_limits_is_bad_input() {
     let Some(ctx) = gpu() else { return };
     let mut scene = assert_accepted(BASE).kernel_scene();
     let limit = ctx.device.limits().max_storage_buffer_binding_size;
-    let quads = (limit / size_of::<glint::shader_types::Quad>() as u64 + 1) as usize;
+    let quads = (limit / size_of::<glint::kernel::types::Quad>() as u64 + 1) as usize;
     let quad = scene.quads[0];
     scene.quads = vec![quad; quads];
     scene.params.quad_count = quads as u32;
@@ -673,7 +674,7 @@ fn gpu_and_cpu_agree_on_scenes_of_every_size() {
         scene.bvh_primitives.clear();
         let mut gpu_renderer = GpuRenderer::with_fastest_kernel(ctx, &scene).unwrap();
         assert_eq!(
-            gpu_renderer.scene_binding() == glint::shader::SceneBinding::Storage,
+            gpu_renderer.scene_binding() == glint::kernel::variant::SceneBinding::Storage,
             n > 2048,
             "{n} spheres"
         );

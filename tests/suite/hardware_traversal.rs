@@ -8,7 +8,7 @@
 use crate::common;
 use common::probe::{run_probe_hardware, ProbeParams};
 use common::{gpu_with_ray_queries, render_cpu, PathAgreement, MESH_SCENE_HEADER};
-use glint::cpu::intersect::NO_HIT;
+use glint::cpu::geometry::intersect::NO_HIT;
 use glint::gpu::{GpuRenderer, Traversal};
 use glint::render::{render_image, Renderer};
 use glint::scene::stress::StressMesh;
@@ -93,7 +93,7 @@ fn hardware_renders_the_cpu_bunny() {
     let Some(ctx) = gpu_with_ray_queries() else {
         return;
     };
-    use glint::compare::compare;
+    use glint::image::compare::compare;
     let render = |renderer: &mut dyn Renderer| {
         while renderer.samples() < 128 {
             renderer.add_samples(32).unwrap();
@@ -105,7 +105,9 @@ fn hardware_renders_the_cpu_bunny() {
     };
     let scene = |seed| common::sized(common::shipped_scene("bunny.toml"), 48, seed);
     let a = render(&mut GpuRenderer::with_traversal(ctx, &scene(1), Traversal::Hardware).unwrap());
-    let b = render(&mut glint::cpu::renderer::CpuRenderer::new(&scene(2)));
+    let b = render(&mut glint::cpu::integrator::renderer::CpuRenderer::new(
+        &scene(2),
+    ));
     let z = compare(&a.0, &b.0, Some((&a.1, &b.1)))
         .unwrap()
         .z_test

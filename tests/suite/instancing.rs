@@ -1,7 +1,7 @@
 //! `[[meshes]] instances`: a mesh file placed many times. An entry with two or more instances
 //! whose materials neither emit, nor are alpha-tested or blended, nor map normals is stored
 //! once, in its own coordinates, and traced through the two-level structure (one BVH per
-//! mesh, instances as leaves of the scene's BVH: src/scene/kernel.rs, shaders/traverse/blas.wgsl);
+//! mesh, instances as leaves of the scene's BVH: src/kernel/scene.rs, shaders/traverse/blas.wgsl);
 //! other entries are flattened into the scene's triangles as before (`load_placed`). The
 //! two-level scene renders the flattened one's image (the same paths, up to the rounding of
 //! testing rays in each instance's coordinates) on both devices, finds the brute-force scan's
@@ -13,16 +13,17 @@ use crate::common;
 use common::probe::{run_probe_bvh, ProbeParams};
 use common::{gpu, render_cpu, render_gpu, MESH_SCENE_HEADER};
 use glam::{Mat4, Vec3};
-use glint::cpu::instance::transform_point;
-use glint::cpu::intersect::{
+use glint::cpu::core::ray::Ray;
+use glint::cpu::core::rng::Rng;
+use glint::cpu::geometry::instance::transform_point;
+use glint::cpu::geometry::intersect::{
     closest_primitive, escapes, first_hit_is, scan_closest_primitive, Geometry, NO_HIT,
 };
-use glint::cpu::rng::Rng;
-use glint::cpu::trace::SceneRefs;
-use glint::cpu::Ray;
+use glint::cpu::integrator::trace::SceneRefs;
+use glint::kernel::types::{NO_INSTANCE, PRIMITIVE_QUAD};
+use glint::kernel::KernelScene;
 use glint::scene::stress::StressMesh;
-use glint::scene::{KernelScene, Scene, SceneError};
-use glint::shader_types::{NO_INSTANCE, PRIMITIVE_QUAD};
+use glint::scene::{Scene, SceneError};
 use std::path::Path;
 
 /// The placements the tests use: translated, rotated, scaled uniformly and per axis, and two
@@ -125,10 +126,10 @@ fn instances_are_the_flattened_meshes_on_the_cpu() {
         &render_cpu(&instanced_kernel, 1),
         0.99,
     );
-    use glint::compare::compare;
+    use glint::image::compare::compare;
     use glint::render::Renderer;
     let render = |scene: &KernelScene| {
-        let mut renderer = glint::cpu::renderer::CpuRenderer::new(scene);
+        let mut renderer = glint::cpu::integrator::renderer::CpuRenderer::new(scene);
         while renderer.samples() < 64 {
             renderer.add_samples(16).unwrap();
         }

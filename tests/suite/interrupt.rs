@@ -7,7 +7,7 @@
 #![allow(clippy::single_range_in_vec_init)]
 
 use crate::common;
-use glint::partial::Partial;
+use glint::render::partial::Partial;
 use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
@@ -117,7 +117,7 @@ fn stop_with(signal_name: &str, code: i32) {
     assert!(n > 0 && n < 1_000_000, "{n} spp");
     assert_eq!(out.info.ranges, vec![0..n]);
     // The variance image is of the same samples as the image.
-    let variance = glint::output::Image::read_exr(&d.join("out.var.exr")).unwrap();
+    let variance = glint::image::output::Image::read_exr(&d.join("out.var.exr")).unwrap();
     assert_eq!(variance, out.accumulation.variance_image());
     // And the file resumes: one more batch on top of it.
     let resumed = render_command(d, &["--spp", "1000000", "--resume", "out.exr"])

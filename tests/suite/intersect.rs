@@ -3,13 +3,13 @@
 //! self-intersection at several scales.
 
 use glam::Vec3;
-use glint::cpu::intersect::{
+use glint::cpu::core::ray::Ray;
+use glint::cpu::geometry::intersect::{
     closest_primitive, first_hit_is, hit_quad, hit_sphere, intersect_scene, Geometry, NO_HIT,
 };
-use glint::cpu::surface::{offset_ray_origin, sphere_point};
-use glint::cpu::Ray;
+use glint::cpu::geometry::surface::{offset_ray_origin, sphere_point};
+use glint::kernel::types::{Quad, Sphere};
 use glint::scene::{Material, MaterialKind, Quad as SceneQuad, Scene};
-use glint::shader_types::{Quad, Sphere};
 
 fn sphere(center: [f32; 3], radius: f32) -> Sphere {
     Sphere {

@@ -1,19 +1,19 @@
 //! The kernel is valid WGSL and matches the host: naga validates every kernel variant, and its
-//! layouter checks that every Rust struct in src/shader_types.rs has the WGSL struct's offsets and
+//! layouter checks that every Rust struct in src/kernel/types.rs has the WGSL struct's offsets and
 //! size, that the uniform arrays are as large as what the host uploads, and that the texel
 //! windows' bindings (29–31) are the host's. So the host and the kernel cannot drift apart.
 
-use glint::shader::{
-    render_kernel_source, render_kernel_source_for, render_kernel_source_with_texels,
-    KernelFeatures, KernelVariant, ParamsBinding, SceneBinding, SceneCounts, RENDER_ENTRY_POINT,
-    WORKGROUP_SIZE,
-};
-use glint::shader_types::{
+use glint::kernel::texels::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
+use glint::kernel::types::{
     BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
     Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
     TriangleUvs,
 };
-use glint::texel_windows::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
+use glint::kernel::variant::{
+    render_kernel_source, render_kernel_source_for, render_kernel_source_with_texels,
+    KernelFeatures, KernelVariant, ParamsBinding, SceneBinding, SceneCounts, RENDER_ENTRY_POINT,
+    WORKGROUP_SIZE,
+};
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
 
@@ -299,9 +299,9 @@ fn wgsl_constants_match_the_hosts() {
             ref e => panic!("{name} is {e:?}"),
         }
     };
-    use glint::clearcoat_energy as c;
-    use glint::ggx_energy as g;
-    use glint::shader_types as t;
+    use glint::kernel::types as t;
+    use glint::tables::clearcoat as c;
+    use glint::tables::ggx as g;
     for (name, value) in [
         ("MATERIAL_DIFFUSE", t::MATERIAL_DIFFUSE),
         ("MATERIAL_SPECULAR", t::MATERIAL_SPECULAR),
@@ -323,7 +323,7 @@ fn wgsl_constants_match_the_hosts() {
         ("GGX_ENERGY_OFFSET_BB_AVERAGE", g::OFFSET_BB_AVERAGE as u32),
         (
             "SHEEN_ENERGY_SIZE",
-            glint::sheen_energy::SHEEN_ENERGY_SIZE as u32,
+            glint::tables::sheen::SHEEN_ENERGY_SIZE as u32,
         ),
         ("CLEARCOAT_ENERGY_SIZE", c::CLEARCOAT_ENERGY_SIZE as u32),
         ("CLEARCOAT_ENERGY_PART", c::CLEARCOAT_ENERGY_PART as u32),
@@ -539,7 +539,7 @@ fn texel_window_bindings(module: &naga::Module) -> Vec<(u32, u32)> {
     out
 }
 
-/// Split texels (src/texel_windows.rs): the windowed kernel validates in every scene binding,
+/// Split texels (src/kernel/texels.rs): the windowed kernel validates in every scene binding,
 /// with textures on and off, and reads windows 2 to 4 at the bindings the host binds them to,
 /// as read-only arrays of 16-byte texels like binding 21, with the host's window size; the
 /// one-binding kernel declares none of them, so scenes that fit keep their kernel.

@@ -4,8 +4,8 @@
 use crate::common;
 use common::{kernel_scene, render_both};
 use glam::DVec3;
-use glint::output::Image;
-use glint::shader_types::Params;
+use glint::image::output::Image;
+use glint::kernel::types::Params;
 use std::f64::consts::PI;
 use std::path::Path;
 use std::process::Command;
@@ -15,7 +15,7 @@ const ALBEDO: f64 = 0.5;
 /// A camera 6 above a diffuse floor of albedo 0.5 (y = 0, 40 × 40), looking straight down,
 /// one scattering event: a floor point's radiance is only what next-event estimation brings
 /// from the light, and the BSDF-sampled ray escapes into a black background.
-fn floor_scene(light: &str, size: u32, spp: u32) -> glint::scene::KernelScene {
+fn floor_scene(light: &str, size: u32, spp: u32) -> glint::kernel::KernelScene {
     floor_scene_under("", 20.0, light, size, spp)
 }
 
@@ -27,7 +27,7 @@ fn floor_scene_under(
     light: &str,
     size: u32,
     spp: u32,
-) -> glint::scene::KernelScene {
+) -> glint::kernel::KernelScene {
     kernel_scene(&format!(
         r#"
 [camera]
@@ -296,7 +296,7 @@ fn spot_falloff_at_and_between_its_angles() {
     for degrees in [0.0, 10.0, 20.0, 24.0, 27.5, 31.0, 35.0, 40.0, 90.0f64] {
         let r = degrees.to_radians();
         let from_light = glam::Vec3::new(r.sin() as f32, -r.cos() as f32, 0.0);
-        let got = glint::cpu::punctual::spot_falloff(&kernel, from_light) as f64;
+        let got = glint::cpu::lights::punctual::spot_falloff(&kernel, from_light) as f64;
         let expected = gltf_spot_falloff(r.cos(), 20.0, 35.0);
         assert!(
             (got - expected).abs() < 1e-5,
@@ -304,7 +304,7 @@ fn spot_falloff_at_and_between_its_angles() {
         );
     }
     assert_eq!(
-        glint::cpu::punctual::spot_falloff(&kernel, glam::Vec3::NEG_Y),
+        glint::cpu::lights::punctual::spot_falloff(&kernel, glam::Vec3::NEG_Y),
         1.0
     );
 }

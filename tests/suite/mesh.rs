@@ -8,12 +8,13 @@
 use crate::common;
 use common::{gpu, render_cpu, render_gpu, PathAgreement, MESH_SCENE_HEADER};
 use glam::Vec3;
-use glint::cpu::intersect::{closest_primitive, first_hit_is, Geometry, NO_HIT};
-use glint::cpu::rng::Rng;
-use glint::cpu::trace::SceneRefs;
-use glint::cpu::Ray;
+use glint::cpu::core::ray::Ray;
+use glint::cpu::core::rng::Rng;
+use glint::cpu::geometry::intersect::{closest_primitive, first_hit_is, Geometry, NO_HIT};
+use glint::cpu::integrator::trace::SceneRefs;
+use glint::kernel::KernelScene;
 use glint::scene::stress::StressMesh;
-use glint::scene::{KernelScene, Scene};
+use glint::scene::Scene;
 
 /// A scene file in a temporary folder next to the stress mesh `mesh.ply` (segments × rings).
 fn scene_with_stress_mesh(
@@ -249,7 +250,7 @@ smooth = {smooth}
 /// and 256 spp with different seeds. The mesh is rendered on the GPU where there is one.
 #[test]
 fn cornell_mesh_renders_the_cornell_box() {
-    use glint::compare::compare;
+    use glint::image::compare::compare;
     use glint::render::Renderer;
     let render = |renderer: &mut dyn Renderer| {
         while renderer.samples() < 256 {
@@ -265,9 +266,11 @@ fn cornell_mesh_renders_the_cornell_box() {
     assert!(!mesh.bvh_nodes.is_empty());
     let a = match gpu() {
         Some(ctx) => render(&mut glint::gpu::GpuRenderer::new(ctx, &mesh).unwrap()),
-        None => render(&mut glint::cpu::renderer::CpuRenderer::new(&mesh)),
+        None => render(&mut glint::cpu::integrator::renderer::CpuRenderer::new(
+            &mesh,
+        )),
     };
-    let b = render(&mut glint::cpu::renderer::CpuRenderer::new(
+    let b = render(&mut glint::cpu::integrator::renderer::CpuRenderer::new(
         &common::cornell_at(64, 2),
     ));
     let z = compare(&a.0, &b.0, Some((&a.1, &b.1)))
@@ -409,12 +412,14 @@ material = "floor"
             256,
         ),
         None => common::render_with_variance(
-            &mut glint::cpu::renderer::CpuRenderer::new(&tessellated),
+            &mut glint::cpu::integrator::renderer::CpuRenderer::new(&tessellated),
             256,
         ),
     };
-    let b =
-        common::render_with_variance(&mut glint::cpu::renderer::CpuRenderer::new(&analytic), 256);
+    let b = common::render_with_variance(
+        &mut glint::cpu::integrator::renderer::CpuRenderer::new(&analytic),
+        256,
+    );
     // Pixels whose centre ray passes within 1 − s − (half a pixel diagonal at the sphere) of
     // the centre.
     let pixel_angle = (vfov.to_radians() / 2.0).tan() * 2.0 / size as f64;

@@ -7,7 +7,7 @@
 //! where it is installed.
 
 use glam::{Mat4, Vec3};
-use glint::output::Image;
+use glint::image::output::Image;
 use glint::scene::light::{Light, LightKind};
 use glint::scene::mesh::{gltf_camera, gltf_lights, LUMENS_PER_WATT};
 use glint::scene::model::{load_model, ModelOptions};

@@ -126,15 +126,15 @@ fn aim(i: u32) -> Vec3 {
 const EYE: Vec3 = Vec3::new(0.0, 0.0, 5.0);
 
 /// The shading normals the CPU finds along the probe's rays.
-fn cpu_normals(scene: &glint::scene::KernelScene) -> Vec<[f32; 4]> {
-    use glint::cpu::intersect::intersect_scene;
-    use glint::cpu::normal_map::normal_mapped;
-    use glint::cpu::texture::material_at;
-    use glint::cpu::trace::SceneRefs;
+fn cpu_normals(scene: &glint::kernel::KernelScene) -> Vec<[f32; 4]> {
+    use glint::cpu::geometry::intersect::intersect_scene;
+    use glint::cpu::integrator::trace::SceneRefs;
+    use glint::cpu::textures::normal_map::normal_mapped;
+    use glint::cpu::textures::texture::material_at;
     let refs = SceneRefs::of(scene, &scene.params);
     (0..256)
         .map(|i| {
-            let ray = glint::cpu::Ray {
+            let ray = glint::cpu::core::ray::Ray {
                 origin: EYE,
                 dir: (aim(i) - EYE).normalize(),
             };
@@ -176,7 +176,7 @@ fn check(gltf: String, tangent: Vec3, bitangent: Vec3) {
 
 /// The quad's shading normals against [`expected`], on the CPU and through the probe on the
 /// GPU.
-fn check_scene(scene: glint::scene::KernelScene, tangent: Vec3, bitangent: Vec3) {
+fn check_scene(scene: glint::kernel::KernelScene, tangent: Vec3, bitangent: Vec3) {
     let cpu = cpu_normals(&scene);
     for (i, n) in cpu.iter().enumerate() {
         let want = expected(i as u32, tangent, bitangent);

@@ -1,13 +1,13 @@
-//! The glTF PBR material (`type = "pbr"`, src/cpu/pbr.rs): energy conservation in a white
+//! The glTF PBR material (`type = "pbr"`, src/cpu/materials/pbr.rs): energy conservation in a white
 //! furnace at every angle and roughness, reciprocity, GPU ≡ CPU, and bad input. Its sampler's
 //! χ² tests are in tests/suite/chi2.rs.
 
 use crate::common;
 use common::{gpu, render_cpu, render_gpu, render_with_variance, PathAgreement};
 use glam::Vec3;
-use glint::cpu::material::{bsdf_eval, bsdf_sample};
-use glint::cpu::rng::Rng;
-use glint::shader_types::{Material, MATERIAL_PBR};
+use glint::cpu::core::rng::Rng;
+use glint::cpu::materials::material::{bsdf_eval, bsdf_sample};
+use glint::kernel::types::{Material, MATERIAL_PBR};
 use std::path::Path;
 
 fn pbr(base: f32, metallic: f32, roughness: f32, specular: f32, ior: f32) -> Material {
@@ -67,7 +67,7 @@ fn a_white_pbr_material_reflects_everything_at_every_angle() {
     }
 }
 
-/// The GGX albedo tables (src/ggx_energy.rs) read between their grid points, where every
+/// The GGX albedo tables (src/tables/ggx.rs) read between their grid points, where every
 /// material's α falls, agree with the albedo integrated there directly on a grid 64 times
 /// finer: within 0.4% of the albedo, a small part of the furnaces' 1% (deterministic: no
 /// sampling noise). Worst measured: 0.3% for roughness 1 head-on (μ = 1 lies beyond the last
@@ -75,8 +75,8 @@ fn a_white_pbr_material_reflects_everything_at_every_angle() {
 /// 0.001 and 0.032 was 2% off at cos θ 0.05–0.1.
 #[test]
 fn the_ggx_tables_are_accurate_between_their_grid_points() {
-    use glint::cpu::ggx_energy::ggx_albedo;
-    use glint::ggx_energy::albedo_split_at_resolution;
+    use glint::cpu::materials::ggx_energy::ggx_albedo;
+    use glint::tables::ggx::albedo_split_at_resolution;
     let mut worst = 0.0f64;
     for roughness in [0.0f32, 0.05, 0.1, 0.15, 0.2, 0.3, 0.45, 0.7, 1.0] {
         let alpha = (roughness * roughness).max(1e-3);
@@ -117,7 +117,7 @@ const WHITE_STACKS: [(f32, f32); 7] = [
 /// the coat's smallest α, 10⁻³), plus 5 standard errors of the estimate (from the sample
 /// weights' variance). Measured before the GGX tables were spaced in roughness and the coat's
 /// and the base's scalings normalised together: up to 2.5% off for coat roughness 0.1. Before
-/// the specular lobes' scaling was normalised over their spread (`src/clearcoat_energy.rs`):
+/// the specular lobes' scaling was normalised over their spread (`src/tables/clearcoat.rs`):
 /// up to −4.3% over full metal of roughness 0.5 under a coat of roughness 0 or 0.1.
 #[test]
 fn a_coat_over_a_white_pbr_stack_reflects_everything() {

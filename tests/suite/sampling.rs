@@ -3,8 +3,8 @@
 //! 10×10 grid of cos²θ and φ.
 
 use glam::Vec3;
-use glint::cpu::diffuse::sample_cosine_hemisphere;
-use glint::cpu::rng::{pcg_hash, Rng};
+use glint::cpu::core::rng::{pcg_hash, Rng};
+use glint::cpu::materials::diffuse::sample_cosine_hemisphere;
 
 #[test]
 fn pcg_hash_known_answers() {
@@ -74,7 +74,7 @@ fn cosine_hemisphere_is_cosine_distributed() {
         Vec3::new(1.0, 2.0, -0.5).normalize(),
         Vec3::X,
     ] {
-        let (t, b) = glint::cpu::frame::basis(n);
+        let (t, b) = glint::cpu::core::frame::basis(n);
         let mut counts = [0u64; 100];
         let n_samples = 1_000_000u64;
         let mut rng = Rng::new(0, 0, 0, 7);

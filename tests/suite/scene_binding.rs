@@ -1,4 +1,4 @@
-//! The kernel variants (src/shader.rs): uniform and storage scene bindings render bit-identical
+//! The kernel variants (src/kernel/variant.rs): uniform and storage scene bindings render bit-identical
 //! images, and so do kernels with features compiled out and the kernel with all of them; a
 //! 700-quad scene goes through storage buffers and traces the CPU's paths; a kernel lacking a
 //! feature the scene needs is refused.
@@ -6,16 +6,16 @@
 use crate::common;
 use common::{gpu, render_cpu, shipped_scene, shipped_scene_text, sized};
 use glint::gpu::GpuRenderer;
-use glint::output::Image;
-use glint::render::render_image;
-use glint::scene::bvh::kernel_stack_size;
-use glint::scene::bvh_layout::BvhLayout;
-use glint::scene::bvh_wide;
-use glint::scene::KernelScene;
-use glint::shader::{
+use glint::image::output::Image;
+use glint::kernel::bvh::kernel_stack_size;
+use glint::kernel::bvh::layout::BvhLayout;
+use glint::kernel::bvh::wide;
+use glint::kernel::variant::{
     bvh_uniform_nodes, bvh_wide_uniform_nodes, KernelFeatures, KernelVariant, SceneBinding,
     SceneCounts, MAX_UNIFORM_SCENE_BYTES,
 };
+use glint::kernel::KernelScene;
+use glint::render::render_image;
 
 fn render_with(scene: &KernelScene, binding: SceneBinding, spp: u32) -> Image {
     let ctx = gpu().unwrap();
@@ -144,7 +144,7 @@ fn bvh_top_nodes_fill_the_uniform_limit() {
         },
         BvhLayout::Wide => SceneBinding::WideBvh {
             uniform_nodes: 512,
-            stack_size: bvh_wide::kernel_stack_size(&bunny.bvh_wide_nodes),
+            stack_size: wide::kernel_stack_size(&bunny.bvh_wide_nodes),
         },
     };
     assert_eq!(SceneBinding::for_scene(&bunny, 65536), expected);
@@ -186,7 +186,7 @@ fn bvh_top_nodes_in_a_uniform_buffer_do_not_change_the_image() {
             assert_eq!(differing, 0, "{name} with {uniform_nodes} uniform nodes");
         }
         // The same for the wide tree (whose 512 uniform nodes hold all of the bunny's).
-        let wide_stack = bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes);
+        let wide_stack = wide::kernel_stack_size(&scene.bvh_wide_nodes);
         let wide_storage_only = render_with(
             &scene,
             SceneBinding::WideBvh {
@@ -275,7 +275,7 @@ fn compiled_out_features_do_not_change_the_image() {
         let differing = differing_pixels(&a, &b);
         eprintln!("{name}: {:?}: {differing} pixels differ", features);
         // Not one pixel may differ: the coat's normal is its own value in every variant
-        // (shaders/trace.wgsl), so none merges the coat's arithmetic with the base's, which
+        // (shaders/integrator/trace.wgsl), so none merges the coat's arithmetic with the base's, which
         // the kernel with every feature cannot, and rounds it otherwise (one pixel in 1024
         // parted in the coated pbr scene before).
         assert!(differing == 0, "{name}: {differing} pixels differ");
@@ -326,7 +326,7 @@ fn a_kernel_lacking_a_needed_feature_is_refused() {
 
 /// The longest root-to-leaf path below the root of a tree laid out as `bvh::build` does, by a
 /// recursive walk (the function under test makes one breadth-first pass).
-fn levels_below_root(nodes: &[glint::shader_types::BvhNode], i: usize) -> u32 {
+fn levels_below_root(nodes: &[glint::kernel::types::BvhNode], i: usize) -> u32 {
     let node = nodes[i];
     if node.count > 0 {
         return 0;
@@ -344,10 +344,10 @@ fn the_traversal_stack_fits_the_tree() {
         .map(|name| (name.to_string(), sized(shipped_scene(name), 8, 0)))
         .collect();
     // Deeper trees: the benchmark's bumpy spheres (18 to 30 levels here).
-    for case in glint::bench::mesh_cases(&[1000, 30000], true) {
+    for case in glint::render::bench::mesh_cases(&[1000, 30000], true) {
         trees.push((
             format!("{case:?}"),
-            glint::bench::case_scene(&case).unwrap(),
+            glint::render::bench::case_scene(&case).unwrap(),
         ));
     }
     for (name, scene) in &trees {

@@ -6,7 +6,7 @@
 
 use crate::common;
 use common::{render_with_variance, with_light_sampling};
-use glint::compare::compare;
+use glint::image::compare::compare;
 use glint::scene::Scene;
 use std::f32::consts::PI;
 use std::fmt::Write;

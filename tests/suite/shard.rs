@@ -8,11 +8,11 @@
 #![allow(clippy::single_range_in_vec_init)]
 
 use crate::common;
-use glint::accumulation::Accumulation;
-use glint::compare::compare;
-use glint::cpu::renderer::CpuRenderer;
+use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::gpu::GpuRenderer;
-use glint::partial::Partial;
+use glint::image::compare::compare;
+use glint::render::accumulation::Accumulation;
+use glint::render::partial::Partial;
 use glint::render::Renderer;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -118,10 +118,10 @@ fn shards_merge_to_the_single_render(device: &str) {
         "{device}: merged differs by {worst} × the bound"
     );
     // The variance image is M2/(n(n−1)) of the merged statistics.
-    let variance = glint::output::Image::read_exr(&d.join("merged.var.exr")).unwrap();
+    let variance = glint::image::output::Image::read_exr(&d.join("merged.var.exr")).unwrap();
     assert_eq!(variance, merged.accumulation.variance_image());
     // Any EXR reader sees the mean as the RGB image.
-    let rgb = glint::output::Image::read_exr(&d.join("merged.exr")).unwrap();
+    let rgb = glint::image::output::Image::read_exr(&d.join("merged.exr")).unwrap();
     assert_eq!(rgb.pixels, merged.accumulation.mean);
 }
 
@@ -439,7 +439,7 @@ fn damaged_partial_files_are_refused_without_a_panic() {
         &["format.exr", "glint.format"],
     );
     // A plain EXR that is no partial file, and a file that is no EXR at all.
-    glint::output::Image {
+    glint::image::output::Image {
         width: 2,
         height: 2,
         pixels: vec![[0.5; 3]; 4],
@@ -535,7 +535,7 @@ fn sample_ranges_and_shards_are_checked_before_rendering() {
 /// environment map and textures), different when anything that changes the image changes.
 #[test]
 fn settings_hash_is_stable_across_loads_and_sees_changes() {
-    use glint::partial::settings_hash;
+    use glint::render::partial::settings_hash;
     for name in ["bunny.toml", "sun.toml", "cornell-textured.toml"] {
         let first = settings_hash(&common::shipped_scene(name).kernel_scene());
         let again = settings_hash(&common::shipped_scene(name).kernel_scene());

@@ -8,7 +8,7 @@
 #![allow(clippy::single_range_in_vec_init)]
 
 use crate::common;
-use glint::partial::Partial;
+use glint::render::partial::Partial;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};

@@ -18,12 +18,13 @@
 
 use crate::common;
 use common::gpu;
-use glint::compare::{compare, ZTest};
-use glint::cpu::renderer::CpuRenderer;
+use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::gpu::GpuRenderer;
-use glint::output::Image;
+use glint::image::compare::{compare, ZTest};
+use glint::image::output::Image;
+use glint::kernel::KernelScene;
 use glint::render::Renderer;
-use glint::scene::{KernelScene, RenderOverrides, Scene};
+use glint::scene::{RenderOverrides, Scene};
 use std::path::Path;
 
 const MIN_PASS_RATE: f64 = 0.97;

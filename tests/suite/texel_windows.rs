@@ -1,4 +1,4 @@
-//! Texels split over several storage bindings (src/texel_windows.rs): a scene whose two images
+//! Texels split over several storage bindings (src/kernel/texels.rs): a scene whose two images
 //! straddle forced 256-texel windows renders on the GPU bit for bit as the one-binding kernel
 //! does, and traces the CPU's paths; a scene needing more windows than four is exit-2 input.
 
@@ -6,10 +6,11 @@ use crate::common;
 
 use glint::error::InputError;
 use glint::gpu::GpuRenderer;
+use glint::kernel::texels::TexelBinding;
+use glint::kernel::types::TEXTURE_CHECKER;
+use glint::kernel::KernelScene;
 use glint::render::render_image;
-use glint::scene::{KernelScene, Scene};
-use glint::shader_types::TEXTURE_CHECKER;
-use glint::texel_windows::TexelBinding;
+use glint::scene::Scene;
 use std::path::Path;
 
 /// The artificial binding limit: 256 texels of 16 bytes per window.

@@ -8,8 +8,8 @@ use crate::common;
 
 use base64::Engine as _;
 use common::{render_with_variance, renderers, PathAgreement};
+use glint::kernel::types::PRIMITIVE_TRIANGLE;
 use glint::scene::Scene;
-use glint::shader_types::PRIMITIVE_TRIANGLE;
 use std::f64::consts::PI;
 
 const STRENGTH: f64 = 4.0;

@@ -9,10 +9,11 @@ use crate::common;
 
 use common::probe::{run_probe, ProbeParams};
 use glam::{Vec2, Vec3};
-use glint::cpu::texture::{both_sets, texture_lookup, Textures};
+use glint::cpu::textures::texture::{both_sets, texture_lookup, Textures};
+use glint::kernel::types::TriangleUvs;
+use glint::kernel::KernelScene;
 use glint::scene::image::srgb_to_linear;
-use glint::scene::{KernelScene, Scene};
-use glint::shader_types::TriangleUvs;
+use glint::scene::Scene;
 use std::path::Path;
 
 /// An 8-bit RGB PNG, rows top first.
@@ -268,7 +269,7 @@ fn the_textured_cornell_box_traces_the_same_paths_on_both_devices() {
     let mut agreement = common::PathAgreement::default();
     for seed in [3, 4] {
         let scene = common::sized(common::shipped_scene("cornell-textured.toml"), 48, seed);
-        assert!(glint::shader::KernelFeatures::of(&scene).textures);
+        assert!(glint::kernel::variant::KernelFeatures::of(&scene).textures);
         agreement.add(
             &common::render_cpu(&scene, 1),
             &common::render_gpu(ctx, &scene, 1),
@@ -485,7 +486,7 @@ fn the_cli_exits_with_2_and_writes_nothing() {
 }
 
 /// A texture set larger than the device's storage binding limit renders on the GPU, its
-/// texels split over two bindings (src/texel_windows.rs; tests/suite/texel_windows.rs checks the
+/// texels split over two bindings (src/kernel/texels.rs; tests/suite/texel_windows.rs checks the
 /// image). lavapipe allows 128 MiB per binding: 4096×2049 texels of 16 bytes are just over it.
 /// Devices with a larger limit skip this (the image cap of 2²⁴ texels per file keeps such a
 /// test affordable only here). Texels beyond four bindings are refused: tests/suite/texel_windows.rs.
@@ -514,7 +515,7 @@ fn a_texture_larger_than_one_binding_renders_on_the_gpu() {
     assert!(run.status.success(), "{stderr}");
     // The quad fills the view under a white sky, one bounce: every pixel is the texel's
     // colour, sRGB-decoded, times the sky (1), the path's one bounce escaping.
-    let image = glint::output::Image::read_exr(&out).unwrap();
+    let image = glint::image::output::Image::read_exr(&out).unwrap();
     let want = [200u8, 100, 50].map(|c| srgb_to_linear(c as f32 / 255.0));
     for p in &image.pixels {
         for c in 0..3 {
@@ -531,7 +532,7 @@ fn a_texture_larger_than_one_binding_renders_on_the_gpu() {
 /// u = 0.5 facing +x, 0.75 facing −z, 1 at the seam facing −x; v = 1 at the top pole.
 #[test]
 fn sphere_coordinates() {
-    use glint::cpu::texture::{polynomial_atan2, sphere_uv};
+    use glint::cpu::textures::texture::{polynomial_atan2, sphere_uv};
     let mut worst = 0.0f64;
     for i in 0..20_000 {
         let angle = i as f64 / 20_000.0 * std::f64::consts::TAU;
@@ -669,7 +670,7 @@ fn gltf_texcoords_and_base_color_texture() {
 /// - a transform that swaps u and v: (0.75, 0.375) reads what (0.375, 0.75) reads untransformed.
 #[test]
 fn wrap_modes_nearest_filtering_and_transforms() {
-    use glint::shader_types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
+    use glint::kernel::types::{TEXTURE_NEAREST, TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR};
     let dir = tempfile::tempdir().unwrap();
     let (width, height) = (4u32, 2u32);
     write_png(&dir.path().join("t.png"), width, height, distinct);

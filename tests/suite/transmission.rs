@@ -8,9 +8,9 @@
 use crate::common;
 use common::render_with_variance;
 use glam::Vec3;
-use glint::cpu::dielectric::fresnel_dielectric;
-use glint::cpu::rng::Rng;
-use glint::cpu::rough_dielectric::{rough_dielectric_eval, rough_dielectric_sample};
+use glint::cpu::core::rng::Rng;
+use glint::cpu::materials::dielectric::fresnel_dielectric;
+use glint::cpu::materials::rough_dielectric::{rough_dielectric_eval, rough_dielectric_sample};
 use std::path::Path;
 
 const IOR: f32 = 1.5;
@@ -152,7 +152,7 @@ fn kept(alpha: f32, etap: f32, mu: f32, samples: u32) -> (f64, f64) {
 }
 
 /// The white furnace of the rough dielectric alone, energy-compensated (Kulla and Conty
-/// 2017, src/cpu/rough_dielectric.rs): from either side of the surface, at every roughness,
+/// 2017, src/cpu/materials/rough_dielectric.rs): from either side of the surface, at every roughness,
 /// it keeps all the energy arriving at each cos θo in {0.2, 0.5, 0.8, 1}, within 1% (the
 /// issue's bound, which the tables' interpolation in μ, α and η must stay under) plus 5
 /// standard errors of the mean weight (each estimate's own sample variance over 200 000
@@ -337,10 +337,10 @@ fn transmission_and_volume_reach_the_kernel() {
     assert_eq!(m.transmission, 1.0);
     assert_eq!(m.attenuation_color, [0.5, 0.8, 1.0]);
     assert_eq!(m.attenuation_distance, 2.5);
-    let features = glint::shader::KernelFeatures::of(&scene);
+    let features = glint::kernel::variant::KernelFeatures::of(&scene);
     assert!(features.transmission && features.volume);
     let cornell = common::cornell_at(8, 1);
-    let features = glint::shader::KernelFeatures::of(&cornell);
+    let features = glint::kernel::variant::KernelFeatures::of(&cornell);
     assert!(!features.transmission && !features.volume);
 }
 
@@ -403,8 +403,8 @@ material = "m"
 /// Tolerance: f32 rounding of two independent computations, 0.5%.
 #[test]
 fn sample_weights_are_eval_over_pdf() {
-    use glint::cpu::pbr::{pbr_eval, pbr_lobes, pbr_pdf};
-    use glint::cpu::rough_dielectric::rough_dielectric_pdf;
+    use glint::cpu::materials::pbr::{pbr_eval, pbr_lobes, pbr_pdf};
+    use glint::cpu::materials::rough_dielectric::rough_dielectric_pdf;
     let mut checked = 0;
     for alpha in [0.04f32, 0.25, 1.0] {
         for etap in [IOR, 1.0 / IOR] {
@@ -429,9 +429,9 @@ fn sample_weights_are_eval_over_pdf() {
         }
     }
     for (transmission, front) in [(1.0f32, true), (0.5, true), (0.5, false)] {
-        let m = glint::shader_types::Material {
+        let m = glint::kernel::types::Material {
             albedo: [0.9, 0.6, 0.3],
-            kind: glint::shader_types::MATERIAL_PBR,
+            kind: glint::kernel::types::MATERIAL_PBR,
             alpha: 0.2,
             ior: IOR,
             specular: 1.0,
@@ -442,7 +442,14 @@ fn sample_weights_are_eval_over_pdf() {
         for i in 0..20_000u32 {
             let mut r = Rng::new(i, 4, 5, 6);
             let wo = random_direction(&mut r, 1.0);
-            let s = glint::cpu::material::bsdf_sample(&m, wo, Vec3::Z, Vec3::Z, front, &mut r);
+            let s = glint::cpu::materials::material::bsdf_sample(
+                &m,
+                wo,
+                Vec3::Z,
+                Vec3::Z,
+                front,
+                &mut r,
+            );
             if s.weight == Vec3::ZERO {
                 continue;
             }

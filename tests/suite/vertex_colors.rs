@@ -7,11 +7,12 @@
 use crate::common;
 
 use glam::{Vec3, Vec4};
-use glint::cpu::renderer::CpuRenderer;
+use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::gpu::{GpuRenderer, Traversal};
-use glint::output::Image;
+use glint::image::output::Image;
+use glint::kernel::KernelScene;
 use glint::render::{render_image, Renderer};
-use glint::scene::{KernelScene, Scene};
+use glint::scene::Scene;
 use std::path::Path;
 
 /// The square's corners: A is (−1, −1), (1, −1), (1, 1); B is (−1, −1), (1, 1), (−1, 1).
@@ -290,7 +291,7 @@ fn meshes_without_vertex_colors_upload_none() {
     .unwrap_or_else(|e| panic!("{e}"))
     .kernel_scene();
     assert!(scene.triangle_colors.is_empty());
-    assert!(!glint::shader::KernelFeatures::of(&scene).vertex_colors);
+    assert!(!glint::kernel::variant::KernelFeatures::of(&scene).vertex_colors);
 }
 
 /// COLOR_0 accessors glTF does not allow, and colours outside [0, 1], are errors naming the

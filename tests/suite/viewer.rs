@@ -278,7 +278,7 @@ fn a_resize_restarts_at_the_new_size() {
     );
     let first_big = frames(&log).into_iter().find(|f| f["width"] == 64).unwrap();
     assert_eq!(first_big["spp"], 1, "the new size starts from a preview");
-    let exr = glint::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
+    let exr = glint::image::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
     assert_eq!((exr.width, exr.height), (64, 32));
 }
 
@@ -549,7 +549,7 @@ fn a_scene_replaced_by_a_fifo_or_dev_zero_does_not_freeze_the_window() {
 /// Whether Open Image Denoise loads here; where it does not, the denoising test says so and
 /// passes, except under GLINT_REQUIRE_OIDN (set by .ci/run, which installs it).
 fn oidn_available() -> bool {
-    match glint::denoise::oidn() {
+    match glint::image::denoise::oidn() {
         Ok(_) => true,
         Err(e) if std::env::var_os("GLINT_REQUIRE_OIDN").is_some() => {
             panic!("GLINT_REQUIRE_OIDN is set: {e}")
@@ -722,7 +722,7 @@ fn d_without_oidn_keeps_the_raw_image_and_says_why_once() {
     }
 }
 
-/// A PNG screenshot goes through `--tonemap` and `--exposure` (src/tonemap.rs) exactly; an EXR
+/// A PNG screenshot goes through `--tonemap` and `--exposure` (src/image/tonemap.rs) exactly; an EXR
 /// one stays linear. Same flags and frames, so both runs hold the same samples.
 #[test]
 fn tonemap_and_exposure_shape_png_screenshots_only() {
@@ -758,9 +758,9 @@ fn tonemap_and_exposure_shape_png_screenshots_only() {
         .unwrap();
         succeeded(&out);
     }
-    let linear = glint::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
-    let expected = glint::tonemap::DisplayTransform {
-        tonemap: glint::tonemap::Tonemap::Agx,
+    let linear = glint::image::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
+    let expected = glint::image::tonemap::DisplayTransform {
+        tonemap: glint::image::tonemap::Tonemap::Agx,
         exposure: 1.5,
     }
     .image(&linear)

@@ -1,11 +1,11 @@
-//! The viewer's display pass: naga validates shaders/display.wgsl (with tonemap.wgsl), the Rust
+//! The viewer's display pass: naga validates shaders/viewer/display.wgsl (with tonemap.wgsl), the Rust
 //! uniform matches the WGSL struct, and on the GPU the pass shows mean × 2^exposure through each
 //! tone curve, sRGB-encoded, the bytes a PNG of the same mean holds (±1), for sRGB and plain
-//! surface formats (src/tonemap.rs is the CPU side).
+//! surface formats (src/image/tonemap.rs is the CPU side).
 
 use crate::common;
-use glint::output::srgb_byte;
-use glint::tonemap::{DisplayTransform, Tonemap};
+use glint::image::output::srgb_byte;
+use glint::image::tonemap::{DisplayTransform, Tonemap};
 use glint::viewer::display::{
     DisplayPass, DisplayUniform, DISPLAY_SHADER, FRAGMENT_ENTRY_POINT, VERTEX_ENTRY_POINT,
 };

@@ -1,15 +1,15 @@
 //! The bottom level of the two-level structure (WGSL side: `shaders/traverse/blas.wgsl`): an
-//! instance in the top-level BVH (`src/cpu/bvh.rs`) is hit by walking its mesh's own BVH, laid
+//! instance in the top-level BVH (`src/cpu/traverse/bvh.rs`) is hit by walking its mesh's own BVH, laid
 //! out in `bvh_nodes` after the top level's, with the ray in the mesh's coordinates
-//! (`src/cpu/instance.rs`). The walk is `bvh_traverse`'s, over triangles only, written again
+//! (`src/cpu/geometry/instance.rs`). The walk is `bvh_traverse`'s, over triangles only, written again
 //! as the kernel must (WGSL has no recursion nor function parameters).
 
-use crate::cpu::alpha::hit_scene_triangle;
-use crate::cpu::bvh::{bvh_ray, hit_box, widened, BVH_STACK_SIZE};
-use crate::cpu::instance::object_ray;
-use crate::cpu::intersect::{hit_comes_first, Geometry, NO_HIT};
-use crate::cpu::Ray;
-use crate::shader_types::PRIMITIVE_INDEX_MASK;
+use crate::cpu::core::ray::Ray;
+use crate::cpu::geometry::alpha::hit_scene_triangle;
+use crate::cpu::geometry::instance::object_ray;
+use crate::cpu::geometry::intersect::{hit_comes_first, Geometry, NO_HIT};
+use crate::cpu::traverse::bvh::{bvh_ray, hit_box, widened, BVH_STACK_SIZE};
+use crate::kernel::types::PRIMITIVE_INDEX_MASK;
 
 /// An instance's closest triangle: its t (`NO_HIT` for none), its index in the triangle
 /// arrays, and how far the walk still looked once it had it (max of t and the entry into its

@@ -1,6 +1,7 @@
-//! Traversal structures other than the scene's binary BVH (`super::bvh`), one file each,
-//! mirroring `shaders/traverse/`: the instances' own trees (`blas`) and the 4-wide tree
-//! (`wide`). Which tree a device runs is chosen once, in `scene::bvh_layout`.
+//! Finding the closest hit along a ray (`shaders/traverse/`): the scene's binary BVH (`bvh`),
+//! the instances' own trees (`blas`) and the 4-wide tree (`wide`). Which tree a device runs is
+//! chosen once, in `kernel::bvh::layout`.
 
 pub mod blas;
+pub mod bvh;
 pub mod wide;

@@ -1,14 +1,14 @@
 //! 4-wide BVH traversal (WGSL side: `shaders/traverse/wide.wgsl`), over the tree
-//! `src/scene/bvh_wide.rs` collapses from the binary one. The meaning and the arguments are
-//! `bvh_traverse`'s (`src/cpu/bvh.rs`), and so are the leaves' tests and bookkeeping
+//! `src/kernel/bvh/wide.rs` collapses from the binary one. The meaning and the arguments are
+//! `bvh_traverse`'s (`src/cpu/traverse/bvh.rs`), and so are the leaves' tests and bookkeeping
 //! (`hit_primitive`, `hit_comes_first`, the leaf-entry pruning): only the inner nodes differ.
 //! A node's four boxes are tested at once, and its children are pushed farthest first, so
 //! the nearest is visited next; entries popped beyond the best hit so far are skipped.
 
-use crate::cpu::bvh::{hit_primitive, widened, BvhRay, BOX_SLACK, NO_PRIMITIVE};
-use crate::cpu::intersect::{hit_comes_first, ClosestPrimitive, Geometry, NO_HIT};
-use crate::scene::bvh_wide::WIDE_STACK_SIZE;
-use crate::shader_types::{
+use crate::cpu::geometry::intersect::{hit_comes_first, ClosestPrimitive, Geometry, NO_HIT};
+use crate::cpu::traverse::bvh::{hit_primitive, widened, BvhRay, BOX_SLACK, NO_PRIMITIVE};
+use crate::kernel::bvh::wide::WIDE_STACK_SIZE;
+use crate::kernel::types::{
     BvhWideNode, NO_INSTANCE, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,
     WIDE_EMPTY_CHILD,
 };
@@ -16,7 +16,7 @@ use glam::{BVec4A, Vec4};
 
 /// Where the ray enters each of the node's four child boxes (0 when it starts inside), or
 /// `NO_HIT` where it misses the box, enters it beyond `t_max`, or the slot holds no child.
-/// Each child's is `hit_box`'s arithmetic (src/cpu/bvh.rs), on four boxes at once: the same
+/// Each child's is `hit_box`'s arithmetic (src/cpu/traverse/bvh.rs), on four boxes at once: the same
 /// IEEE operations, and no NaN can arise (inv_dir is finite and non-zero).
 pub fn hit_wide_boxes(node: &BvhWideNode, r: &BvhRay, t_max: f32) -> Vec4 {
     let slab = |min: [f32; 4], max: [f32; 4], origin: f32, inv: f32| {
@@ -48,7 +48,7 @@ pub fn farthest_first(t: Vec4) -> [u32; 4] {
     [a & 3, b & 3, c & 3, d & 3]
 }
 
-/// `bvh_traverse` (src/cpu/bvh.rs) through the wide tree: the same results, bit for bit.
+/// `bvh_traverse` (src/cpu/traverse/bvh.rs) through the wide tree: the same results, bit for bit.
 pub fn wide_traverse(
     geometry: &Geometry,
     r: &BvhRay,

@@ -4,9 +4,9 @@
 
 use super::gltf::exists;
 use super::{check_emission, check_ior, check_normal_scale, check_reflectance};
+use crate::kernel::types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use crate::scene::texture::Sampling;
 use crate::scene::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
-use crate::shader_types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use glam::Vec3;
 use gltf::json;
 use json::texture::{MagFilter, WrappingMode};

@@ -44,7 +44,7 @@ pub const MAX_TRIANGLES: usize = 1 << 28;
 pub const MAX_PLACED_TRIANGLES: usize = 1 << 25;
 
 /// The most instances a scene's instanced meshes may have in all: their transforms
-/// (`shader_types::Instance`, 112 bytes each) fill one 128 MiB binding at about 1.2·10⁶.
+/// (`kernel::types::Instance`, 112 bytes each) fill one 128 MiB binding at about 1.2·10⁶.
 pub const MAX_INSTANCES: usize = 1 << 20;
 
 /// Triangle `t` moved by `matrix`: its vertices, its normals through the inverse transpose of

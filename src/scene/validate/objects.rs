@@ -24,7 +24,7 @@ pub(super) struct Objects {
 }
 
 /// One warning per material that is alpha-tested or blended but used by spheres or quads,
-/// which are always opaque (src/cpu/alpha.rs): alpha applies to meshes only.
+/// which are always opaque (src/cpu/geometry/alpha.rs): alpha applies to meshes only.
 fn opaque_only_warnings(spheres: &[Sphere], quads: &[Quad], materials: &[Material]) -> Vec<String> {
     let used = spheres
         .iter()

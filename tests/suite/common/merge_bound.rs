@@ -1,6 +1,6 @@
 //! How far two accumulations of the same samples may differ: float rounding only.
 
-use glint::accumulation::Accumulation;
+use glint::render::accumulation::Accumulation;
 
 /// The largest |a − b| over every pixel channel of two accumulations of the same samples
 /// (merged shards against a single render, or a resumed render against an uninterrupted one),

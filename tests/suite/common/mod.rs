@@ -5,11 +5,12 @@ pub mod chi2;
 pub mod merge_bound;
 pub mod probe;
 
-use glint::cpu::renderer::CpuRenderer;
+use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::gpu::{GpuContext, GpuRenderer};
-use glint::output::Image;
+use glint::image::output::Image;
+use glint::kernel::KernelScene;
 use glint::render::{render_image, Renderer};
-use glint::scene::{KernelScene, Scene};
+use glint::scene::Scene;
 use std::path::Path;
 use std::sync::OnceLock;
 

@@ -4,10 +4,10 @@ use bytemuck::{Pod, Zeroable};
 use glint::gpu::binding::{bind_group, compute_layout_entries};
 use glint::gpu::renderer::storage_buffer;
 use glint::gpu::GpuContext;
-use glint::scene::KernelScene;
-use glint::shader::{
+use glint::kernel::variant::{
     render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
 };
+use glint::kernel::KernelScene;
 use wgpu::util::DeviceExt;
 
 /// The probe kernel's parameters (tests/suite/shaders/probe.wgsl).
@@ -63,7 +63,7 @@ pub fn run_probe_bvh(
 ) -> Vec<[f32; 4]> {
     let source = probe_source_with(SceneBinding::Bvh {
         uniform_nodes: 1,
-        stack_size: glint::scene::bvh::kernel_stack_size(&scene.bvh_nodes),
+        stack_size: glint::kernel::bvh::kernel_stack_size(&scene.bvh_nodes),
     });
     run_probe_source(ctx, entry, params, scene, source)
 }
@@ -78,7 +78,7 @@ pub fn run_probe_bvh_wide(
 ) -> Vec<[f32; 4]> {
     let source = probe_source_with(SceneBinding::WideBvh {
         uniform_nodes: 1,
-        stack_size: glint::scene::bvh_wide::kernel_stack_size(&scene.bvh_wide_nodes),
+        stack_size: glint::kernel::bvh::wide::kernel_stack_size(&scene.bvh_wide_nodes),
     });
     run_probe_source(ctx, entry, params, scene, source)
 }
@@ -159,21 +159,21 @@ fn run_probe_with(
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let lights = storage_buffer(ctx, "lights", &scene.lights);
-    let ggx_energy = storage_buffer(ctx, "GGX energy", glint::ggx_energy::ggx_energy_table());
+    let ggx_energy = storage_buffer(ctx, "GGX energy", glint::tables::ggx::ggx_energy_table());
     let dielectric_energy = storage_buffer(
         ctx,
         "dielectric energy",
-        glint::dielectric_energy::dielectric_energy_table(),
+        glint::tables::dielectric::dielectric_energy_table(),
     );
     let clearcoat_energy = storage_buffer(
         ctx,
         "clear coat energy",
-        glint::clearcoat_energy::clearcoat_energy_table(),
+        glint::tables::clearcoat::clearcoat_energy_table(),
     );
     let sheen_energy = storage_buffer(
         ctx,
         "sheen energy",
-        glint::sheen_energy::sheen_energy_table(),
+        glint::tables::sheen::sheen_energy_table(),
     );
     let size = params.count as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {

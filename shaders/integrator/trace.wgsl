@@ -1,0 +1,224 @@
+// Path tracing kernel (mirror: src/cpu/integrator/trace.rs): one invocation per pixel adds
+// params.sample_count samples, starting at global sample index params.sample_start.
+
+// Segments this invocation traced; added to `segments_traced` once at the end.
+var<private> segments: u32 = 0u;
+
+// A path in flight: what one more segment needs.
+struct PathState {
+    ray: Ray,
+    throughput: vec3<f32>,
+    radiance: vec3<f32>,
+    // The surface point the current ray left from (light pdfs are evaluated there).
+    ray_start: vec3<f32>,
+    // How the current ray was sampled, for weighting the emitter it may hit.
+    bsdf_pdf_of_ray: f32,
+    bounce: u32,
+    came_from_delta: bool,
+    // Albedo, normal and depth for the denoiser (aov.wgsl); untouched unless AOVS.
+    aov: PathAov,
+}
+
+// Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
+// most params.radiance_clamp in its brightest channel, hue kept; 0 turns it off.
+fn firefly_clamp(contribution: vec3<f32>, scatterings: u32) -> vec3<f32> {
+    let peak = max(contribution.x, max(contribution.y, contribution.z));
+    if scatterings > 0u && params.radiance_clamp > 0.0 && peak > params.radiance_clamp {
+        return contribution * (params.radiance_clamp / peak);
+    }
+    return contribution;
+}
+
+fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
+    var camera_rng = rng_init(pixel, sample, 0u, params.seed);
+    let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
+    let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
+    let ray = camera_ray(px, py, jitter, lens);
+    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true, aov_start());
+}
+
+// Traces one segment of the path (and its shadow ray); true when the path has ended.
+fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
+    let ray = (*path).ray;
+    let bounce = (*path).bounce;
+    let light_sampling = LIGHT_SAMPLING && params.light_sampling != 0u && emitter_count() > 0u;
+    if HAS_ALPHA {
+        // This segment's alpha decisions (alpha.wgsl): segment `bounce`, the one the ray
+        // leaving the previous vertex (or the camera) opened.
+        alpha_key = alpha_segment_key(pixel, sample, bounce);
+    }
+    var hit = intersect_scene(ray);
+    segments += 1u;
+    if hit.t == NO_HIT {
+        var escaped = params.background;
+        if HAS_ENVIRONMENT {
+            escaped = environment_radiance(ray.dir);
+        }
+        if aovs_on() {
+            (*path).aov = aov_record_miss((*path).aov, escaped);
+        }
+        if HAS_ENVIRONMENT {
+            // The map is an emitter like the others: a BSDF-sampled ray that reaches it
+            // shares its light with next-event estimation from the previous vertex.
+            if light_sampling && !(*path).came_from_delta {
+                let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, PRIMITIVE_ENVIRONMENT, 0u);
+                escaped *= power_heuristic((*path).bsdf_pdf_of_ray, pdf);
+            }
+        }
+        if HAS_SUN_DISKS {
+            let mis = light_sampling && !(*path).came_from_delta;
+            escaped += sun_disks_radiance(ray.dir, (*path).bsdf_pdf_of_ray, mis);
+        }
+        (*path).radiance += firefly_clamp((*path).throughput * escaped, bounce);
+        return true;
+    }
+    let m = vertex_colored(material_at(materials[hit.material], hit.uv), hit);
+    // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
+    // else the unmapped one; the base's normal map does not reach it. Normalised again (the
+    // same vector but for rounding) so that no kernel variant can prove it the base's and
+    // merge the coat's arithmetic with the base's: every variant rounds the coat alike
+    // (tests/suite/scene_binding.rs). Only where a coat is compiled in: nothing else reads it.
+    var coat_normal = hit.shading_normal;
+    if HAS_CLEARCOAT {
+        coat_normal = normalize(coat_normal);
+    }
+    if HAS_TEXTURES && hit.primitive == PRIMITIVE_TRIANGLE {
+        if HAS_CLEARCOAT && m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
+            coat_normal = normal_mapped(hit, m.clearcoat_normal_texture, m.clearcoat_normal_scale, -ray.dir);
+        }
+        if m.normal_texture != NO_TEXTURE {
+            hit.shading_normal = normal_mapped(hit, m.normal_texture, m.normal_scale, -ray.dir);
+        }
+    }
+    if aovs_on() {
+        (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
+    }
+    if HAS_VOLUME && !hit.front_face {
+        // The segment ran inside the volume this surface bounds (volume.wgsl).
+        (*path).throughput *= volume_transmittance(m, hit.t);
+    }
+    if any(m.emission > vec3<f32>(0.0)) {
+        // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
+        // from the previous vertex; camera rays and delta bounces count in full.
+        var weight = 1.0;
+        if light_sampling && !(*path).came_from_delta {
+            let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
+            weight = power_heuristic((*path).bsdf_pdf_of_ray, pdf);
+        }
+        (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, bounce);
+    }
+    // max_bounces counts scattering events; this also bounds every path's length.
+    if bounce >= params.max_bounces {
+        return true;
+    }
+    let p = hit.position;
+    let wo = -ray.dir;
+    let origin = offset_ray_origin(p, hit.error, hit.normal);
+    if light_sampling && !is_delta(m) {
+        // Next-event estimation: light arriving after one more scattering event.
+        var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
+        let light = sample_light(p, origin, &light_rng);
+        if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
+            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
+            if any(f_cos > vec3<f32>(0.0)) {
+                segments += 1u;
+                if HAS_ALPHA {
+                    // The shadow ray leaves this vertex as the next bounce's ray will: the same
+                    // segment's key, so both see the same blended triangles.
+                    alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
+                }
+                if light_visible(Ray(origin, light.dir), light) {
+                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
+                    let weight = nee_weight(light, pdf);
+                    let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
+                    (*path).radiance += firefly_clamp(contribution, bounce + 1u);
+                }
+            }
+        }
+    }
+    var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+    let s = bsdf_sample(m, wo, hit.shading_normal, coat_normal, hit.front_face, &bsdf_rng);
+    var throughput = (*path).throughput * s.weight;
+    if all(throughput == vec3<f32>(0.0)) || crosses_shading_side(s.dir, hit) {
+        return true;
+    }
+    if bounce >= params.roulette_start {
+        // Russian roulette: continue with probability q and divide by it, so the estimate
+        // stays unbiased while dim paths end early.
+        var roulette_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed);
+        let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
+        if rng_next(&roulette_rng) >= q {
+            return true;
+        }
+        throughput /= q;
+    }
+    (*path).throughput = throughput;
+    (*path).came_from_delta = s.is_delta;
+    (*path).bsdf_pdf_of_ray = s.pdf;
+    // Leave on the side the new direction goes to.
+    let side = select(-hit.normal, hit.normal, dot(s.dir, hit.normal) >= 0.0);
+    (*path).ray = Ray(offset_ray_origin(p, hit.error, side), s.dir);
+    (*path).ray_start = p;
+    (*path).bounce = bounce + 1u;
+    return false;
+}
+
+// One camera path through pixel (px, py), traced to its end: its radiance, and its AOVs.
+fn trace_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
+    var path = start_path(pixel, px, py, sample);
+    loop {
+        if path_step(&path, pixel, sample) {
+            break;
+        }
+    }
+    return path;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn render(@builtin(global_invocation_id) id: vec3<u32>) {
+    let px = id.x + tile_origin.x;
+    let py = id.y + tile_origin.y;
+    if px >= params.width || py >= params.height || params.sample_count == 0u {
+        return;
+    }
+    let pixel = py * params.width + px;
+    var acc = accumulator_start(params.accumulated_samples, accum_mean[pixel].xyz, accum_m2[pixel].xyz);
+    var aov_mean = aov_mean_start();
+    // Path regeneration: one loop over segments, and a lane whose path ends starts its next
+    // sample at once, instead of idling until the longest path among its SIMD neighbours
+    // ends. Each sample's result is the same as trace_path's (the random numbers depend on
+    // the sample, not on the schedule), and samples finish in order.
+    var done = 0u;
+    var path = start_path(pixel, px, py, params.sample_start);
+    loop {
+        if path_step(&path, pixel, params.sample_start + done) {
+            add_sample(&acc, path.radiance, params.sample_start + done);
+            if aovs_on() {
+                aov_mean_add(&aov_mean, path.aov, done);
+            }
+            done += 1u;
+            if done == params.sample_count {
+                break;
+            }
+            path = start_path(pixel, px, py, params.sample_start + done);
+        }
+    }
+    // lavapipe (llvmpipe's gallivm) silently ends every loop of an invocation once all its
+    // loops together have made 65535 iterations; the path loop then stops short. Write
+    // nothing and let the host report it (src/gpu/loop_budget.rs keeps batches below it).
+    if done < params.sample_count {
+        atomicAdd(&accumulate_counters[1], 1u);
+        return;
+    }
+    // A batch the host ends inside a block keeps the statistics right.
+    merge_block(&acc);
+    accum_mean[pixel] = vec4<f32>(acc.mean, 0.0);
+    accum_m2[pixel] = vec4<f32>(acc.m2, 0.0);
+    if aovs_on() {
+        aov_merge(pixel, aov_mean, f32(params.accumulated_samples), f32(params.sample_count));
+    }
+    atomicAdd(&segments_traced, segments);
+    if acc.nonfinite > 0u {
+        atomicAdd(&accumulate_counters[0], acc.nonfinite);
+    }
+}

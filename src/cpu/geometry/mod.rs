@@ -1,0 +1,9 @@
+//! Ray–primitive intersection and the surface at a hit (`shaders/geometry/`): spheres, quads,
+//! triangles (with alpha testing), instances, and the shading normal.
+
+pub mod alpha;
+pub mod instance;
+pub mod intersect;
+pub mod shading_normal;
+pub mod surface;
+pub mod triangle;

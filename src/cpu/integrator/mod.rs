@@ -1,0 +1,8 @@
+//! The path tracer itself (`shaders/integrator/`): the path loop, Beer–Lambert volumes, the
+//! denoiser's AOVs, per-pixel accumulation, and the CPU renderer that runs it over tiles.
+
+pub mod accumulate;
+pub mod aov;
+pub mod renderer;
+pub mod trace;
+pub mod volume;

@@ -1,0 +1,475 @@
+//! Path tracing (WGSL side: `shaders/integrator/trace.wgsl`).
+
+use crate::cpu::core::camera::camera_ray;
+use crate::cpu::core::ray::Ray;
+use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
+use crate::cpu::geometry::alpha::{alpha_segment_key, AlphaTest};
+use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene, Geometry, NO_HIT};
+use crate::cpu::geometry::surface::offset_ray_origin;
+use crate::cpu::integrator::accumulate::{accumulator_start, add_sample, merge_block};
+use crate::cpu::integrator::aov::{
+    aov_mean_add, aov_merge, aov_record_hit, aov_record_miss, aov_start, aovs_on, AovMean, PathAov,
+};
+use crate::cpu::integrator::volume::volume_transmittance;
+use crate::cpu::lights::environment::environment_radiance;
+use crate::cpu::lights::punctual::sun_disks_radiance;
+use crate::cpu::lights::sampling::{
+    light_pdf, light_visible, nee_weight, power_heuristic, sample_light,
+};
+use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
+use crate::cpu::textures::normal_map::normal_mapped;
+use crate::cpu::textures::texture::{material_at, Textures};
+use crate::cpu::textures::vertex_color::vertex_colored;
+use crate::kernel::bvh::layout::BvhLayout;
+use crate::kernel::types::{
+    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
+    Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
+    TriangleUvs, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
+};
+use crate::kernel::variant::has_alpha;
+use crate::kernel::KernelScene;
+use glam::Vec3;
+
+/// The scene as the kernel sees it.
+#[derive(Clone, Copy)]
+pub struct SceneRefs<'a> {
+    pub params: &'a Params,
+    pub spheres: &'a [Sphere],
+    pub quads: &'a [Quad],
+    pub materials: &'a [Material],
+    pub emitters: &'a [Emitter],
+    pub triangles: &'a [Triangle],
+    pub triangle_normals: &'a [TriangleNormals],
+    /// Empty: every ray tests every primitive.
+    pub bvh_nodes: &'a [BvhNode],
+    pub bvh_primitives: &'a [u32],
+    /// Empty: no instanced meshes.
+    pub instances: &'a [Instance],
+    /// The 4-wide tree where the CPU traverses it (src/kernel/bvh/layout.rs), else empty.
+    pub bvh_wide_nodes: &'a [BvhWideNode],
+    /// Texture descriptors and texels (`texture.rs`); empty without textures.
+    pub textures: &'a [Texture],
+    pub texels: &'a [[f32; 4]],
+    pub triangle_uvs: &'a [TriangleUvs],
+    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
+    /// empty.
+    pub triangle_uvs1: &'a [TriangleUvs],
+    /// One per triangle when a material has a normal map, else empty.
+    pub triangle_tangents: &'a [TriangleTangents],
+    /// One per triangle when a mesh has vertex colours, else empty.
+    pub triangle_colors: &'a [TriangleColors],
+    /// Empty without an environment map.
+    pub environment_texels: &'a [EnvironmentTexel],
+    pub environment_alias: &'a [EnvironmentAlias],
+    /// Point, spot and directional lights (`punctual.rs`).
+    pub lights: &'a [Light],
+    /// What intersection reads: the arrays above, and the key of the ray segment being traced
+    /// (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`. Built once
+    /// here, not per ray: building it for every ray and shadow ray was 3% of a CPU render.
+    pub geometry: Geometry<'a>,
+}
+
+impl<'a> SceneRefs<'a> {
+    /// `scene`'s arrays with `params` in place of its own.
+    pub fn of(scene: &'a KernelScene, params: &'a Params) -> SceneRefs<'a> {
+        let mut refs = SceneRefs {
+            params,
+            spheres: &scene.spheres,
+            quads: &scene.quads,
+            materials: &scene.materials,
+            emitters: &scene.emitters,
+            triangles: &scene.triangles,
+            triangle_normals: &scene.triangle_normals,
+            bvh_nodes: &scene.bvh_nodes,
+            bvh_primitives: &scene.bvh_primitives,
+            instances: &scene.instances,
+            bvh_wide_nodes: match BvhLayout::for_cpu() {
+                BvhLayout::Wide => &scene.bvh_wide_nodes,
+                BvhLayout::Binary => &[],
+            },
+            environment_texels: &scene.environment_texels,
+            environment_alias: &scene.environment_alias,
+            textures: &scene.textures,
+            texels: &scene.texels,
+            triangle_uvs: &scene.triangle_uvs,
+            triangle_uvs1: &scene.triangle_uvs1,
+            triangle_tangents: &scene.triangle_tangents,
+            triangle_colors: &scene.triangle_colors,
+            lights: &scene.lights,
+            geometry: Geometry::default(),
+        };
+        refs.geometry = refs.build_geometry();
+        refs
+    }
+
+    /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
+    pub fn has_alpha(&self) -> bool {
+        self.geometry.alpha.enabled
+    }
+
+    /// What texture lookups read.
+    pub fn textures(&self) -> Textures<'a> {
+        Textures {
+            descriptors: self.textures,
+            texels: self.texels,
+        }
+    }
+
+    /// The same scene tracing the ray segment whose alpha key is `key`.
+    pub fn with_alpha_key(&self, key: u32) -> SceneRefs<'a> {
+        let mut keyed = *self;
+        keyed.geometry.alpha.key = key;
+        keyed
+    }
+
+    /// What intersection reads.
+    pub fn geometry(&self) -> Geometry<'a> {
+        self.geometry
+    }
+
+    fn build_geometry(&self) -> Geometry<'a> {
+        Geometry {
+            spheres: self.spheres,
+            quads: self.quads,
+            triangles: self.triangles,
+            triangle_normals: self.triangle_normals,
+            bvh_nodes: self.bvh_nodes,
+            bvh_primitives: self.bvh_primitives,
+            instances: self.instances,
+            bvh_wide_nodes: self.bvh_wide_nodes,
+            triangle_uvs: self.triangle_uvs,
+            triangle_uvs1: self.triangle_uvs1,
+            textured: !self.textures.is_empty(),
+            alpha: AlphaTest {
+                enabled: has_alpha(self.materials),
+                materials: self.materials,
+                textures: self.textures(),
+                triangle_uvs: self.triangle_uvs,
+                triangle_uvs1: self.triangle_uvs1,
+                triangle_colors: self.triangle_colors,
+                key: 0,
+            },
+        }
+    }
+}
+
+/// A path in flight: what one more segment needs.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState {
+    pub ray: Ray,
+    pub throughput: Vec3,
+    pub radiance: Vec3,
+    /// The surface point the current ray left from (light pdfs are evaluated there).
+    pub ray_start: Vec3,
+    /// How the current ray was sampled, for weighting the emitter it may hit.
+    pub bsdf_pdf_of_ray: f32,
+    pub bounce: u32,
+    pub came_from_delta: bool,
+    /// Albedo, normal and depth for the denoiser (aov.rs); untouched unless `params.aovs`.
+    pub aov: PathAov,
+}
+
+/// Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
+/// most `params.radiance_clamp` in its brightest channel, hue kept; 0 turns it off.
+pub fn firefly_clamp(params: &Params, contribution: Vec3, scatterings: u32) -> Vec3 {
+    let peak = contribution.x.max(contribution.y.max(contribution.z));
+    if scatterings > 0 && params.radiance_clamp > 0.0 && peak > params.radiance_clamp {
+        return contribution * (params.radiance_clamp / peak);
+    }
+    contribution
+}
+
+pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
+    let mut camera_rng = Rng::new(pixel, sample, 0, params.seed);
+    let jitter = (camera_rng.next_f32(), camera_rng.next_f32());
+    let lens = (camera_rng.next_f32(), camera_rng.next_f32());
+    let ray = camera_ray(params, px, py, jitter, lens);
+    PathState {
+        ray,
+        throughput: Vec3::ONE,
+        radiance: Vec3::ZERO,
+        ray_start: ray.origin,
+        bsdf_pdf_of_ray: 0.0,
+        bounce: 0,
+        came_from_delta: true,
+        aov: aov_start(),
+    }
+}
+
+/// Traces one segment of the path (and its shadow ray); true when the path has ended.
+/// `segments` counts the ray segments traced, as the kernel's counter does.
+pub fn path_step(
+    scene: &SceneRefs,
+    path: &mut PathState,
+    pixel: u32,
+    sample: u32,
+    segments: &mut u32,
+) -> bool {
+    let params = scene.params;
+    let ray = path.ray;
+    let bounce = path.bounce;
+    let light_sampling = params.light_sampling != 0 && params.emitter_count > 0;
+    // This segment's alpha decisions (alpha.rs): segment `bounce`, the one the ray leaving the
+    // previous vertex (or the camera) opened. A copy only where alpha is read at all.
+    let keyed;
+    let scene = if scene.has_alpha() {
+        keyed = scene.with_alpha_key(alpha_segment_key(params, pixel, sample, bounce));
+        &keyed
+    } else {
+        scene
+    };
+    let mut hit = intersect_scene(&scene.geometry, &ray);
+    *segments += 1;
+    if hit.t == NO_HIT {
+        // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
+        let mut escaped = Vec3::from(params.background);
+        if params.environment_width > 0 {
+            escaped = environment_radiance(scene, ray.dir);
+        }
+        if aovs_on(params) {
+            aov_record_miss(&mut path.aov, escaped);
+        }
+        if params.environment_width > 0 {
+            // The map is an emitter like the others: a BSDF-sampled ray that reaches it
+            // shares its light with next-event estimation from the previous vertex.
+            if light_sampling && !path.came_from_delta {
+                let pdf = light_pdf(
+                    scene,
+                    path.ray_start,
+                    ray.origin,
+                    ray.dir,
+                    PRIMITIVE_ENVIRONMENT,
+                    0,
+                );
+                escaped *= power_heuristic(path.bsdf_pdf_of_ray, pdf);
+            }
+        }
+        // The kernel compiles sun disks in only for scenes that have one (HAS_SUN_DISKS).
+        if params.light_count > 0 {
+            let mis = light_sampling && !path.came_from_delta;
+            escaped += sun_disks_radiance(scene, ray.dir, path.bsdf_pdf_of_ray, mis);
+        }
+        path.radiance += firefly_clamp(params, path.throughput * escaped, bounce);
+        return true;
+    }
+    // The material as stored, unless textures or vertex colours change it at this hit (the
+    // kernel's HAS_TEXTURES and HAS_VERTEX_COLORS): a 160-byte copy per hit otherwise.
+    let stored = &scene.materials[hit.material as usize];
+    let varied;
+    let m = if scene.textures.is_empty() && scene.triangle_colors.is_empty() {
+        stored
+    } else {
+        varied = vertex_colored(
+            scene.triangle_colors,
+            &material_at(&scene.textures(), stored, hit.uv),
+            &hit,
+        );
+        &varied
+    };
+    // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
+    // else the unmapped one; the base's normal map does not reach it. Normalised again as the
+    // kernel does (shaders/integrator/trace.wgsl says why), where there is a coat: nothing else reads it.
+    let mut coat_normal = hit.shading_normal;
+    if m.clearcoat > 0.0 {
+        coat_normal = coat_normal.normalize();
+    }
+    if hit.primitive == PRIMITIVE_TRIANGLE {
+        if m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
+            coat_normal = normal_mapped(
+                &scene.textures(),
+                &hit,
+                m.clearcoat_normal_texture,
+                m.clearcoat_normal_scale,
+                &scene.triangle_tangents[hit.index as usize],
+                -ray.dir,
+            );
+        }
+        if m.normal_texture != NO_TEXTURE {
+            hit.shading_normal = normal_mapped(
+                &scene.textures(),
+                &hit,
+                m.normal_texture,
+                m.normal_scale,
+                &scene.triangle_tangents[hit.index as usize],
+                -ray.dir,
+            );
+        }
+    }
+    if aovs_on(params) {
+        aov_record_hit(&mut path.aov, bounce, &hit, m);
+    }
+    // The kernel compiles this in only for scenes with attenuating volumes (HAS_VOLUME).
+    if !hit.front_face {
+        path.throughput *= volume_transmittance(m, hit.t);
+    }
+    let emission = Vec3::from(m.emission);
+    if emission.cmpgt(Vec3::ZERO).any() {
+        // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
+        // from the previous vertex; camera rays and delta bounces count in full.
+        let mut weight = 1.0;
+        if light_sampling && !path.came_from_delta {
+            let pdf = light_pdf(
+                scene,
+                path.ray_start,
+                ray.origin,
+                ray.dir,
+                hit.primitive,
+                hit.index,
+            );
+            weight = power_heuristic(path.bsdf_pdf_of_ray, pdf);
+        }
+        path.radiance += firefly_clamp(params, path.throughput * emission * weight, bounce);
+    }
+    // max_bounces counts scattering events; this also bounds every path's length.
+    if bounce >= params.max_bounces {
+        return true;
+    }
+    let p = hit.position;
+    let wo = -ray.dir;
+    let origin = offset_ray_origin(p, hit.error, hit.normal);
+    if light_sampling && !is_delta(m) {
+        // Next-event estimation: light arriving after one more scattering event.
+        let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
+        let light = sample_light(scene, p, origin, &mut light_rng);
+        if light.pdf > 0.0 && !crosses_shading_side(light.dir, &hit) {
+            let f_cos = bsdf_eval(
+                m,
+                wo,
+                light.dir,
+                hit.shading_normal,
+                coat_normal,
+                hit.front_face,
+            );
+            if f_cos.cmpgt(Vec3::ZERO).any() {
+                let shadow = Ray {
+                    origin,
+                    dir: light.dir,
+                };
+                *segments += 1;
+                // The shadow ray leaves this vertex as the next bounce's ray will: the same
+                // segment's key, so both see the same blended triangles.
+                let keyed;
+                let shadow_scene = if scene.has_alpha() {
+                    let key = alpha_segment_key(params, pixel, sample, bounce + 1);
+                    keyed = scene.with_alpha_key(key);
+                    &keyed
+                } else {
+                    scene
+                };
+                if light_visible(shadow_scene, &shadow, &light) {
+                    let pdf = bsdf_pdf(
+                        m,
+                        wo,
+                        light.dir,
+                        hit.shading_normal,
+                        coat_normal,
+                        hit.front_face,
+                    );
+                    let weight = nee_weight(&light, pdf);
+                    let contribution =
+                        path.throughput * f_cos * light.radiance * (weight / light.pdf);
+                    path.radiance += firefly_clamp(params, contribution, bounce + 1);
+                }
+            }
+        }
+    }
+    let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+    let s = bsdf_sample(
+        m,
+        wo,
+        hit.shading_normal,
+        coat_normal,
+        hit.front_face,
+        &mut bsdf_rng,
+    );
+    let mut throughput = path.throughput * s.weight;
+    if throughput == Vec3::ZERO || crosses_shading_side(s.dir, &hit) {
+        return true;
+    }
+    if bounce >= params.roulette_start {
+        // Russian roulette: continue with probability q and divide by it, so the estimate
+        // stays unbiased while dim paths end early.
+        let mut roulette_rng = Rng::new(
+            pixel,
+            sample,
+            stream_id(bounce, PURPOSE_ROULETTE),
+            params.seed,
+        );
+        let q = throughput.x.max(throughput.y.max(throughput.z)).min(0.95);
+        if roulette_rng.next_f32() >= q {
+            return true;
+        }
+        throughput /= q;
+    }
+    path.throughput = throughput;
+    path.came_from_delta = s.is_delta;
+    path.bsdf_pdf_of_ray = s.pdf;
+    // Leave on the side the new direction goes to.
+    let side = if s.dir.dot(hit.normal) >= 0.0 {
+        hit.normal
+    } else {
+        -hit.normal
+    };
+    path.ray = Ray {
+        origin: offset_ray_origin(p, hit.error, side),
+        dir: s.dir,
+    };
+    path.ray_start = p;
+    path.bounce = bounce + 1;
+    false
+}
+
+/// One camera path through pixel (px, py), traced to its end: its radiance, and its AOVs.
+pub fn trace_path(
+    scene: &SceneRefs,
+    pixel: u32,
+    px: u32,
+    py: u32,
+    sample: u32,
+    segments: &mut u32,
+) -> PathState {
+    let mut path = start_path(scene.params, pixel, px, py, sample);
+    while !path_step(scene, &mut path, pixel, sample, segments) {}
+    path
+}
+
+/// Running per-pixel statistics: the mean radiance and M2, the sum of squared deviations.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelStats {
+    pub mean: Vec3,
+    pub m2: Vec3,
+    /// Samples dropped as NaN, infinite or too large (`shaders/integrator/accumulate.wgsl`).
+    pub nonfinite: u32,
+    /// Mean albedo, normal and depth, when `params.aovs` asks for them.
+    pub aov: AovMean,
+}
+
+/// The kernel's entry point for one pixel: `params.sample_count` samples starting at
+/// `params.sample_start`, merged into `stats`, which holds the `params.accumulated_samples`
+/// samples before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
+/// for SIMD efficiency; each sample's result is the same, and they finish in the same order.)
+pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
+    let params = scene.params;
+    let pixel = py * params.width + px;
+    let mut acc = accumulator_start(params.accumulated_samples, stats.mean, stats.m2);
+    let mut aov_mean = AovMean::default();
+    let mut segments = 0;
+    for i in 0..params.sample_count {
+        let sample = params.sample_start + i;
+        let path = trace_path(scene, pixel, px, py, sample, &mut segments);
+        add_sample(&mut acc, path.radiance, sample);
+        if aovs_on(params) {
+            aov_mean_add(&mut aov_mean, &path.aov, i);
+        }
+    }
+    // A batch ended inside a block (the render loop avoids this) keeps the statistics right.
+    merge_block(&mut acc);
+    stats.mean = acc.mean;
+    stats.m2 = acc.m2;
+    stats.nonfinite += acc.nonfinite;
+    if aovs_on(params) {
+        let n_old = params.accumulated_samples as f32;
+        aov_merge(&mut stats.aov, &aov_mean, n_old, params.sample_count as f32);
+    }
+    segments
+}

@@ -1,0 +1,6 @@
+//! Light sampling (`shaders/lights/`): emitters chosen by power, punctual lights and the
+//! environment map, with the MIS weights they share.
+
+pub mod environment;
+pub mod punctual;
+pub mod sampling;

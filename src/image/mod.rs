@@ -1,0 +1,10 @@
+//! What a render becomes: images in files (PNG, EXR: `output`), written atomically after every
+//! output was checked up front (`atomic_write`, `output_check`), tone mapped for display
+//! (`tonemap`), denoised (`denoise`) and compared (`compare`).
+
+pub mod atomic_write;
+pub mod compare;
+pub mod denoise;
+pub mod output;
+pub mod output_check;
+pub mod tonemap;

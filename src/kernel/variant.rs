@@ -1,0 +1,712 @@
+//! The WGSL kernel, assembled from one file per concept in `shaders/` (WGSL has no includes).
+
+use crate::kernel::bvh::layout::BvhLayout;
+use crate::kernel::texels::TexelBinding;
+use crate::kernel::types::{
+    BvhNode, BvhWideNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, LIGHT_SUN,
+    MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
+    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+};
+use crate::kernel::KernelScene;
+
+/// The kernel's parts in dependency order, with their file names, for error messages and tests.
+/// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
+pub const SHADER_PARTS: [(&str, &str); 37] = [
+    (
+        "core/types.wgsl",
+        include_str!("../../shaders/core/types.wgsl"),
+    ),
+    ("core/rng.wgsl", include_str!("../../shaders/core/rng.wgsl")),
+    (
+        "core/camera.wgsl",
+        include_str!("../../shaders/core/camera.wgsl"),
+    ),
+    (
+        "geometry/surface.wgsl",
+        include_str!("../../shaders/geometry/surface.wgsl"),
+    ),
+    (
+        "geometry/shading_normal.wgsl",
+        include_str!("../../shaders/geometry/shading_normal.wgsl"),
+    ),
+    (
+        "geometry/triangle.wgsl",
+        include_str!("../../shaders/geometry/triangle.wgsl"),
+    ),
+    (
+        "geometry/intersect.wgsl",
+        include_str!("../../shaders/geometry/intersect.wgsl"),
+    ),
+    (
+        "traverse/bvh.wgsl",
+        include_str!("../../shaders/traverse/bvh.wgsl"),
+    ),
+    (
+        "geometry/instance.wgsl",
+        include_str!("../../shaders/geometry/instance.wgsl"),
+    ),
+    (
+        "traverse/blas.wgsl",
+        include_str!("../../shaders/traverse/blas.wgsl"),
+    ),
+    (
+        "core/frame.wgsl",
+        include_str!("../../shaders/core/frame.wgsl"),
+    ),
+    (
+        "materials/bsdf.wgsl",
+        include_str!("../../shaders/materials/bsdf.wgsl"),
+    ),
+    (
+        "materials/microfacet.wgsl",
+        include_str!("../../shaders/materials/microfacet.wgsl"),
+    ),
+    (
+        "materials/diffuse.wgsl",
+        include_str!("../../shaders/materials/diffuse.wgsl"),
+    ),
+    (
+        "materials/conductor.wgsl",
+        include_str!("../../shaders/materials/conductor.wgsl"),
+    ),
+    (
+        "materials/dielectric.wgsl",
+        include_str!("../../shaders/materials/dielectric.wgsl"),
+    ),
+    (
+        "materials/ggx_energy.wgsl",
+        include_str!("../../shaders/materials/ggx_energy.wgsl"),
+    ),
+    (
+        "materials/dielectric_energy.wgsl",
+        include_str!("../../shaders/materials/dielectric_energy.wgsl"),
+    ),
+    (
+        "materials/rough_dielectric.wgsl",
+        include_str!("../../shaders/materials/rough_dielectric.wgsl"),
+    ),
+    (
+        "materials/sheen_energy.wgsl",
+        include_str!("../../shaders/materials/sheen_energy.wgsl"),
+    ),
+    (
+        "materials/clearcoat_energy.wgsl",
+        include_str!("../../shaders/materials/clearcoat_energy.wgsl"),
+    ),
+    (
+        "materials/clearcoat.wgsl",
+        include_str!("../../shaders/materials/clearcoat.wgsl"),
+    ),
+    (
+        "materials/sheen.wgsl",
+        include_str!("../../shaders/materials/sheen.wgsl"),
+    ),
+    (
+        "materials/pbr.wgsl",
+        include_str!("../../shaders/materials/pbr.wgsl"),
+    ),
+    (
+        "materials/material.wgsl",
+        include_str!("../../shaders/materials/material.wgsl"),
+    ),
+    (
+        "textures/texture.wgsl",
+        include_str!("../../shaders/textures/texture.wgsl"),
+    ),
+    (
+        "textures/vertex_color.wgsl",
+        include_str!("../../shaders/textures/vertex_color.wgsl"),
+    ),
+    (
+        "geometry/alpha.wgsl",
+        include_str!("../../shaders/geometry/alpha.wgsl"),
+    ),
+    (
+        "textures/normal_map.wgsl",
+        include_str!("../../shaders/textures/normal_map.wgsl"),
+    ),
+    (
+        "lights/environment.wgsl",
+        include_str!("../../shaders/lights/environment.wgsl"),
+    ),
+    (
+        "integrator/volume.wgsl",
+        include_str!("../../shaders/integrator/volume.wgsl"),
+    ),
+    (
+        "lights/sampling.wgsl",
+        include_str!("../../shaders/lights/sampling.wgsl"),
+    ),
+    (
+        "lights/punctual.wgsl",
+        include_str!("../../shaders/lights/punctual.wgsl"),
+    ),
+    (
+        "integrator/aov.wgsl",
+        include_str!("../../shaders/integrator/aov.wgsl"),
+    ),
+    (
+        "integrator/accumulate.wgsl",
+        include_str!("../../shaders/integrator/accumulate.wgsl"),
+    ),
+    (
+        "integrator/tiles.wgsl",
+        include_str!("../../shaders/integrator/tiles.wgsl"),
+    ),
+    (
+        "integrator/trace.wgsl",
+        include_str!("../../shaders/integrator/trace.wgsl"),
+    ),
+];
+
+const SCENE_STORAGE: &str = include_str!("../../shaders/core/scene_storage.wgsl");
+/// The hardware traversal (ray queries), in the hardware variant only.
+const TRAVERSE_HARDWARE: &str = include_str!("../../shaders/traverse/hardware.wgsl");
+/// Its entry points as stubs, in every other variant.
+const TRAVERSE_SOFTWARE_ONLY: &str = include_str!("../../shaders/traverse/software_only.wgsl");
+/// The 4-wide BVH's traversal, in the wide variant only.
+const TRAVERSE_WIDE: &str = include_str!("../../shaders/traverse/wide.wgsl");
+/// Its entry point as a stub, in every other variant.
+const TRAVERSE_BINARY_ONLY: &str = include_str!("../../shaders/traverse/binary_only.wgsl");
+const SCENE_UNIFORM: &str = include_str!("../../shaders/core/scene_uniform.wgsl");
+
+/// Name of the compute entry point in `shaders/integrator/trace.wgsl`.
+pub const RENDER_ENTRY_POINT: &str = "render";
+
+/// Workgroup size of the render kernel, as declared in `shaders/integrator/trace.wgsl`.
+pub const WORKGROUP_SIZE: (u32, u32) = (8, 8);
+
+/// Where the kernel reads the scene's spheres, quads, materials and emitters from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneBinding {
+    /// Storage buffers: any scene, one kernel for all (`shaders/core/scene_storage.wgsl`).
+    Storage,
+    /// Uniform buffers sized for one scene, with the counts compiled in
+    /// (`shaders/core/scene_uniform.wgsl`): 1.2–2.3× faster on lavapipe, for scenes that fit.
+    Uniform(SceneCounts),
+    /// Storage buffers traversed through the scene's BVH (`shaders/traverse/bvh.wgsl`): scenes with
+    /// meshes or many objects, which [`KernelScene::bvh_nodes`] then holds. The first
+    /// `uniform_nodes` nodes (the top levels: the tree is laid out breadth first) are also in
+    /// a uniform buffer, which lavapipe reads far faster ([`bvh_uniform_nodes`]). The
+    /// traversal stack holds `stack_size` entries: enough for the tree
+    /// ([`crate::kernel::bvh::kernel_stack_size`]).
+    Bvh { uniform_nodes: u32, stack_size: u32 },
+    /// The same, traversing the 4-wide tree ([`KernelScene::bvh_wide_nodes`],
+    /// `shaders/traverse/wide.wgsl`) where the GPU's layout is wide
+    /// ([`crate::kernel::bvh::layout`]): `uniform_nodes` of its top in a uniform buffer, a stack of
+    /// `stack_size` entries ([`crate::kernel::bvh::wide::kernel_stack_size`]).
+    WideBvh { uniform_nodes: u32, stack_size: u32 },
+    /// Storage buffers traced with the device's ray queries
+    /// (`shaders/traverse/hardware.wgsl`) against an acceleration structure the host builds
+    /// (`src/gpu/acceleration.rs`): only on devices with `wgpu::Features::EXPERIMENTAL_RAY_QUERY`,
+    /// where a kernel with ray queries compiles. Chosen by `--traversal` (`src/gpu/traversal.rs`),
+    /// never by [`SceneBinding::for_scene`].
+    Hardware,
+}
+
+/// How many of the BVH's top nodes the kernel reads from a uniform buffer on a device whose
+/// uniform bindings hold `max_uniform_binding` bytes: as many as fit in it and in
+/// [`MAX_UNIFORM_SCENE_BYTES`] (2048 on lavapipe and NVIDIA: the top 11 levels).
+/// Why: llvmpipe turns a storage-buffer load whose address differs between lanes into a loop
+/// over the lanes with a branch per lane, a uniform-buffer load into one gather, and a
+/// traversal reads mostly nodes (BENCHMARKS.md, "Why lavapipe's BVH kernel is slow": +45% at
+/// 10³ triangles, whose whole tree fits).
+pub fn bvh_uniform_nodes(max_uniform_binding: u64) -> u32 {
+    let bytes = max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES);
+    (bytes / size_of::<BvhNode>() as u64).max(1) as u32
+}
+
+/// [`bvh_uniform_nodes`] for the wide tree's nodes (512 on lavapipe and NVIDIA: the top 4½
+/// levels).
+pub fn bvh_wide_uniform_nodes(max_uniform_binding: u64) -> u32 {
+    let bytes = max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES);
+    (bytes / size_of::<BvhWideNode>() as u64).max(1) as u32
+}
+
+/// How many of each object a scene has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneCounts {
+    pub spheres: u32,
+    pub quads: u32,
+    pub materials: u32,
+    pub emitters: u32,
+}
+
+impl SceneCounts {
+    pub fn of(scene: &KernelScene) -> SceneCounts {
+        SceneCounts {
+            spheres: scene.spheres.len() as u32,
+            quads: scene.quads.len() as u32,
+            materials: scene.materials.len() as u32,
+            emitters: scene.emitters.len() as u32,
+        }
+    }
+
+    /// Bytes of the largest of the four uniform buffers (each holds at least one element).
+    pub fn largest_uniform_buffer(&self) -> u64 {
+        let bytes = |count: u32, size: usize| count.max(1) as u64 * size as u64;
+        [
+            bytes(self.spheres, size_of::<Sphere>()),
+            bytes(self.quads, size_of::<Quad>()),
+            bytes(self.materials, size_of::<Material>()),
+            bytes(self.emitters, size_of::<Emitter>()),
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0)
+    }
+}
+
+/// The most bytes a uniform array may hold, whatever the device allows: 64 KiB (682 quads), the
+/// limit of lavapipe and NVIDIA. Larger scenes are better served by storage buffers anyway, as
+/// their loops over all objects are too long to unroll.
+pub const MAX_UNIFORM_SCENE_BYTES: u64 = 64 << 10;
+
+impl SceneBinding {
+    /// The fast uniform binding when every array fits in `max_uniform_binding` bytes (the
+    /// device's limit) and in [`MAX_UNIFORM_SCENE_BYTES`], storage buffers otherwise.
+    pub fn for_scene(scene: &KernelScene, max_uniform_binding: u64) -> SceneBinding {
+        // A scene without the binary tree is scanned, as on the CPU, whatever else it holds.
+        if !scene.bvh_nodes.is_empty()
+            && !scene.bvh_wide_nodes.is_empty()
+            && BvhLayout::for_gpu() == BvhLayout::Wide
+        {
+            return SceneBinding::WideBvh {
+                uniform_nodes: bvh_wide_uniform_nodes(max_uniform_binding),
+                stack_size: crate::kernel::bvh::wide::kernel_stack_size(&scene.bvh_wide_nodes),
+            };
+        }
+        if !scene.bvh_nodes.is_empty() {
+            return SceneBinding::Bvh {
+                uniform_nodes: bvh_uniform_nodes(max_uniform_binding),
+                stack_size: crate::kernel::bvh::kernel_stack_size(&scene.bvh_nodes),
+            };
+        }
+        let counts = SceneCounts::of(scene);
+        if counts.largest_uniform_buffer() <= max_uniform_binding.min(MAX_UNIFORM_SCENE_BYTES) {
+            SceneBinding::Uniform(counts)
+        } else {
+            SceneBinding::Storage
+        }
+    }
+
+    /// How many nodes the kernel's uniform copy of the BVH's top holds (`BVH_UNIFORM_NODES`):
+    /// one, unused, in the layouts without a BVH.
+    pub fn uniform_node_count(&self) -> u32 {
+        match self {
+            SceneBinding::Bvh { uniform_nodes, .. } => *uniform_nodes,
+            SceneBinding::Storage
+            | SceneBinding::Uniform(_)
+            | SceneBinding::Hardware
+            | SceneBinding::WideBvh { .. } => 1,
+        }
+    }
+
+    /// The kernel's traversal stack length (`BVH_STACK_SIZE`): one, unused, in the layouts
+    /// without a BVH.
+    pub fn stack_size(&self) -> u32 {
+        match self {
+            SceneBinding::Bvh { stack_size, .. } => *stack_size,
+            SceneBinding::Storage
+            | SceneBinding::Uniform(_)
+            | SceneBinding::Hardware
+            | SceneBinding::WideBvh { .. } => 1,
+        }
+    }
+
+    /// The wide traversal's uniform node count and stack length (`BVH_WIDE_UNIFORM_NODES`,
+    /// `BVH_WIDE_STACK_SIZE`): one each, unused, in the other layouts.
+    pub fn wide_sizes(&self) -> (u32, u32) {
+        match self {
+            SceneBinding::WideBvh {
+                uniform_nodes,
+                stack_size,
+            } => (*uniform_nodes, *stack_size),
+            _ => (1, 1),
+        }
+    }
+
+    /// Short name for benchmarks and logs.
+    pub fn name(&self) -> &'static str {
+        match self {
+            SceneBinding::Storage => "storage",
+            SceneBinding::Uniform(_) => "uniform",
+            SceneBinding::Bvh { .. } => "bvh",
+            SceneBinding::WideBvh { .. } => "bvh-wide",
+            SceneBinding::Hardware => "hardware",
+        }
+    }
+
+    /// Whether the kernel traces with ray queries: it then needs the device feature.
+    pub fn uses_ray_queries(&self) -> bool {
+        matches!(self, SceneBinding::Hardware)
+    }
+
+    /// The WGSL declaring the scene's bindings, as a named part.
+    fn part(&self) -> (&'static str, String) {
+        // Triangles exist only in the storage layouts; the uniform one compiles their code out.
+        // The BVH's constants are declared in every layout, since bvh.wgsl is always compiled.
+        let (wide_nodes, wide_stack) = self.wide_sizes();
+        let wide = matches!(self, SceneBinding::WideBvh { .. });
+        let bvh = format!(
+            "const BVH_UNIFORM_NODES: u32 = {}u;\nconst BVH_STACK_SIZE: u32 = {}u;\n\
+             const BVH_WIDE: bool = {wide};\nconst BVH_WIDE_UNIFORM_NODES: u32 = {wide_nodes}u;\n\
+             const BVH_WIDE_STACK_SIZE: u32 = {wide_stack}u;\n{}",
+            self.uniform_node_count(),
+            self.stack_size(),
+            if wide {
+                TRAVERSE_WIDE
+            } else {
+                TRAVERSE_BINARY_ONLY
+            }
+        );
+        // The traversal's entry points: ray queries in the hardware variant, stubs elsewhere.
+        let hardware = self.uses_ray_queries();
+        let traverse = format!(
+            "const USE_RAY_QUERY: bool = {hardware};\n{}",
+            if hardware {
+                TRAVERSE_HARDWARE
+            } else {
+                TRAVERSE_SOFTWARE_ONLY
+            }
+        );
+        let storage = |use_bvh: bool| {
+            format!(
+                "const USE_BVH: bool = {use_bvh};\nconst HAS_TRIANGLES: bool = true;\n\
+                 {bvh}{SCENE_STORAGE}{traverse}"
+            )
+        };
+        match self {
+            SceneBinding::Storage => ("core/scene_storage.wgsl", storage(false)),
+            SceneBinding::Bvh { .. } | SceneBinding::WideBvh { .. } => {
+                ("core/scene_storage.wgsl", storage(true))
+            }
+            SceneBinding::Hardware => ("core/scene_storage.wgsl", storage(false)),
+            SceneBinding::Uniform(c) => (
+                "core/scene_uniform.wgsl",
+                format!(
+                    "const SPHERE_COUNT: u32 = {}u;\nconst QUAD_COUNT: u32 = {}u;\n\
+                     const MATERIAL_COUNT: u32 = {}u;\nconst EMITTER_COUNT: u32 = {}u;\n\
+                     const USE_BVH: bool = false;\nconst HAS_TRIANGLES: bool = false;\n{bvh}{}{traverse}",
+                    c.spheres, c.quads, c.materials, c.emitters, SCENE_UNIFORM
+                ),
+            ),
+        }
+    }
+}
+
+/// The parts of the kernel a scene needs, compiled in as constants; the rest is compiled out.
+/// Why: lavapipe runs every branch of the path loop for all lanes, under a mask, whether or not
+/// a lane takes it, so code a scene cannot reach still costs time on every segment (compiling
+/// out light sampling halves the time of a render without it). On real GPUs it saves
+/// registers. Each flag only removes code that cannot run for the scene, so images do not
+/// change (tests/suite/scene_binding.rs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KernelFeatures {
+    /// Next-event estimation with MIS (`Params::light_sampling`, with at least one emitter).
+    pub light_sampling: bool,
+    pub sphere_emitters: bool,
+    pub quad_emitters: bool,
+    pub triangle_emitters: bool,
+    pub metal: bool,
+    pub dielectric: bool,
+    /// glTF's metallic-roughness material (shaders/materials/pbr.wgsl) and its energy tables.
+    pub pbr: bool,
+    /// pbr's transmission lobe (shaders/materials/rough_dielectric.wgsl), for pbr materials with
+    /// transmission.
+    pub transmission: bool,
+    /// pbr's KHR_materials_clearcoat layer (shaders/materials/clearcoat.wgsl), for pbr materials with a
+    /// coat.
+    pub clearcoat: bool,
+    /// pbr's KHR_materials_sheen layer (shaders/materials/sheen.wgsl) and its albedo table, for pbr
+    /// materials with a sheen.
+    pub sheen: bool,
+    /// Beer–Lambert attenuation inside meshes (shaders/integrator/volume.wgsl), for materials with an
+    /// attenuation distance.
+    pub volume: bool,
+    /// The denoiser's albedo, normal and depth outputs (`Params::aovs`, shaders/integrator/aov.wgsl).
+    pub aovs: bool,
+    /// Textured materials: texture coordinates at hits and lookups (shaders/textures/texture.wgsl).
+    pub textures: bool,
+    /// An environment map (`[environment]`, shaders/lights/environment.wgsl) in place of the
+    /// constant background, and light sampling of it when that is on.
+    pub environment: bool,
+    /// Point, spot and directional lights, sampled by light sampling (shaders/lights/punctual.wgsl).
+    pub lights: bool,
+    /// Sun disks, which rays that escape can see (with or without light sampling).
+    pub sun_disks: bool,
+    /// Alpha-tested or blended materials (shaders/geometry/alpha.wgsl): without them every triangle hit
+    /// is accepted as before, at the same cost.
+    pub alpha: bool,
+    /// Meshes with vertex colours (glTF's COLOR_0, shaders/textures/vertex_color.wgsl).
+    pub vertex_colors: bool,
+    /// Instanced meshes (shaders/geometry/instance.wgsl, shaders/traverse/blas.wgsl): without them no
+    /// top-level leaf is an instance and every triangle is read as it is stored.
+    pub instances: bool,
+    /// Textures on the second texture coordinate set (glTF's TEXCOORD_1, shaders/textures/texture.wgsl).
+    pub texcoord1: bool,
+}
+
+impl KernelFeatures {
+    /// Everything compiled in: a kernel for any scene and any `Params`.
+    pub const ALL: KernelFeatures = KernelFeatures {
+        light_sampling: true,
+        sphere_emitters: true,
+        quad_emitters: true,
+        triangle_emitters: true,
+        metal: true,
+        dielectric: true,
+        pbr: true,
+        transmission: true,
+        clearcoat: true,
+        sheen: true,
+        volume: true,
+        aovs: true,
+        textures: true,
+        environment: true,
+        lights: true,
+        sun_disks: true,
+        alpha: true,
+        vertex_colors: true,
+        instances: true,
+        texcoord1: true,
+    };
+
+    /// What `scene`, rendered with its own `Params`, can reach.
+    pub fn of(scene: &KernelScene) -> KernelFeatures {
+        let emits = |primitive| scene.emitters.iter().any(|e| e.primitive == primitive);
+        let has_kind = |kind| scene.materials.iter().any(|m| m.kind == kind);
+        let light_sampling = scene.params.light_sampling != 0 && !scene.emitters.is_empty();
+        KernelFeatures {
+            light_sampling,
+            sphere_emitters: emits(PRIMITIVE_SPHERE),
+            quad_emitters: emits(PRIMITIVE_QUAD),
+            triangle_emitters: emits(PRIMITIVE_TRIANGLE),
+            metal: has_kind(MATERIAL_METAL),
+            dielectric: has_kind(MATERIAL_DIELECTRIC),
+            pbr: has_kind(MATERIAL_PBR),
+            transmission: scene.materials.iter().any(|m| {
+                m.kind == MATERIAL_PBR
+                    && (m.transmission > 0.0 || m.transmission_texture != NO_TEXTURE)
+            }),
+            clearcoat: scene
+                .materials
+                .iter()
+                .any(|m| m.kind == MATERIAL_PBR && m.clearcoat > 0.0),
+            sheen: scene
+                .materials
+                .iter()
+                .any(|m| m.kind == MATERIAL_PBR && m.sheen_color.iter().any(|&c| c > 0.0)),
+            volume: scene.materials.iter().any(|m| m.attenuation_distance > 0.0),
+            aovs: scene.params.aovs != 0,
+            textures: !scene.textures.is_empty(),
+            environment: scene.params.environment_width > 0,
+            lights: light_sampling && emits(PRIMITIVE_LIGHT),
+            sun_disks: scene
+                .lights
+                .iter()
+                .any(|l| l.kind == LIGHT_SUN && l.sun_one_minus_cos > 0.0),
+            alpha: has_alpha(&scene.materials),
+            vertex_colors: !scene.triangle_colors.is_empty(),
+            instances: !scene.instances.is_empty(),
+            texcoord1: !scene.triangle_uvs1.is_empty(),
+        }
+    }
+
+    /// Whether a kernel with these features renders everything `other` needs.
+    pub fn covers(&self, other: &KernelFeatures) -> bool {
+        let needs = |have: bool, need: bool| have || !need;
+        needs(self.light_sampling, other.light_sampling)
+            && needs(self.sphere_emitters, other.sphere_emitters)
+            && needs(self.quad_emitters, other.quad_emitters)
+            && needs(self.triangle_emitters, other.triangle_emitters)
+            && needs(self.metal, other.metal)
+            && needs(self.dielectric, other.dielectric)
+            && needs(self.pbr, other.pbr)
+            && needs(self.transmission, other.transmission)
+            && needs(self.clearcoat, other.clearcoat)
+            && needs(self.sheen, other.sheen)
+            && needs(self.volume, other.volume)
+            && needs(self.aovs, other.aovs)
+            && needs(self.textures, other.textures)
+            && needs(self.environment, other.environment)
+            && needs(self.lights, other.lights)
+            && needs(self.sun_disks, other.sun_disks)
+            && needs(self.alpha, other.alpha)
+            && needs(self.vertex_colors, other.vertex_colors)
+            && needs(self.instances, other.instances)
+            && needs(self.texcoord1, other.texcoord1)
+    }
+
+    /// The WGSL constants that turn the features on and off.
+    fn part(&self) -> String {
+        format!(
+            "const LIGHT_SAMPLING: bool = {};\nconst HAS_SPHERE_EMITTERS: bool = {};\n\
+             const HAS_QUAD_EMITTERS: bool = {};\nconst HAS_TRIANGLE_EMITTERS: bool = {};\n\
+             const HAS_METAL: bool = {};\nconst HAS_DIELECTRIC: bool = {};\nconst HAS_PBR: bool = {};\n\
+             const HAS_TRANSMISSION: bool = {};\nconst HAS_CLEARCOAT: bool = {};\n\
+             const HAS_SHEEN: bool = {};\nconst HAS_VOLUME: bool = {};\n\
+             const AOVS: bool = {};\n\
+             const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
+             const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
+             const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
+             const HAS_TEXCOORD_1: bool = {};\nconst HAS_INSTANCES: bool = {};\n",
+            self.light_sampling,
+            self.sphere_emitters,
+            self.quad_emitters,
+            self.triangle_emitters,
+            self.metal,
+            self.dielectric,
+            self.pbr,
+            self.pbr && self.transmission,
+            self.pbr && self.clearcoat,
+            self.pbr && self.sheen,
+            self.volume,
+            self.aovs,
+            self.textures,
+            self.environment,
+            self.lights,
+            self.sun_disks,
+            self.alpha,
+            self.vertex_colors,
+            self.textures && self.texcoord1,
+            self.instances
+        )
+    }
+}
+
+/// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`).
+pub fn has_alpha(materials: &[Material]) -> bool {
+    materials.iter().any(|m| m.alpha_mode != ALPHA_OPAQUE)
+}
+
+/// One compiled form of the kernel: where it reads the scene from, and what it compiles in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KernelVariant {
+    pub binding: SceneBinding,
+    pub features: KernelFeatures,
+}
+
+impl KernelVariant {
+    /// The kernel for any scene: storage buffers, every feature.
+    pub const GENERAL: KernelVariant = KernelVariant {
+        binding: SceneBinding::Storage,
+        features: KernelFeatures::ALL,
+    };
+
+    /// The fastest kernel for `scene` on a device whose uniform bindings hold
+    /// `max_uniform_binding` bytes.
+    pub fn for_scene(scene: &KernelScene, max_uniform_binding: u64) -> KernelVariant {
+        KernelVariant {
+            binding: SceneBinding::for_scene(scene, max_uniform_binding),
+            features: KernelFeatures::of(scene),
+        }
+    }
+
+    /// [`KernelVariant::for_scene`]'s kernel with storage buffers where that has uniform ones:
+    /// the same features, but nothing of the scene's size compiled in, so that scenes using
+    /// the same features share one kernel. It renders the same image
+    /// (tests/suite/scene_binding.rs), a little more slowly. (A kernel with every feature
+    /// would serve every scene, but lavapipe takes minutes to compile it.)
+    pub fn shared_for(scene: &KernelScene, max_uniform_binding: u64) -> KernelVariant {
+        let fastest = KernelVariant::for_scene(scene, max_uniform_binding);
+        match fastest.binding {
+            SceneBinding::Uniform(_) => KernelVariant {
+                binding: SceneBinding::Storage,
+                ..fastest
+            },
+            _ => fastest,
+        }
+    }
+
+    /// The kernel a renderer takes unless told otherwise: [`KernelVariant::for_scene`]'s, or
+    /// [`KernelVariant::shared_for`]'s where `GLINT_KERNEL_VARIANT=shared` says so. On
+    /// lavapipe, compiling a kernel takes seconds and rendering a test's few pixels
+    /// milliseconds, so the test suite (scripts/test) renders through shared kernels; the
+    /// uniform variants themselves are tested by asking for them.
+    pub fn default_for(scene: &KernelScene, max_uniform_binding: u64) -> KernelVariant {
+        if shared_kernel_requested() {
+            KernelVariant::shared_for(scene, max_uniform_binding)
+        } else {
+            KernelVariant::for_scene(scene, max_uniform_binding)
+        }
+    }
+}
+
+/// `GLINT_KERNEL_VARIANT`, read once: `shared` or `fastest` (the default); anything else is
+/// ignored with a warning.
+fn shared_kernel_requested() -> bool {
+    static SHARED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *SHARED.get_or_init(|| match std::env::var("GLINT_KERNEL_VARIANT").as_deref() {
+        Ok("shared") => true,
+        Ok("fastest") | Err(_) => false,
+        Ok(other) => {
+            crate::errln!(
+                "glint: GLINT_KERNEL_VARIANT={other} is neither shared nor fastest; ignored"
+            );
+            false
+        }
+    })
+}
+
+/// The whole kernel as one WGSL module, for any scene ([`KernelVariant::GENERAL`]).
+pub fn render_kernel_source() -> String {
+    render_kernel_source_for(KernelVariant::GENERAL)
+}
+
+/// Where the kernel reads its `Params` from (src/gpu/inline_uniforms.rs chooses per device).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamsBinding {
+    Uniform,
+    /// A read-only storage buffer, whose values drivers never compile into the kernel.
+    Storage,
+}
+
+impl ParamsBinding {
+    /// The WGSL address space of the declaration.
+    pub fn address_space(&self) -> &'static str {
+        match self {
+            ParamsBinding::Uniform => "uniform",
+            ParamsBinding::Storage => "storage, read",
+        }
+    }
+}
+
+/// The whole kernel as one WGSL module, in the given variant, with `Params` in a uniform buffer.
+pub fn render_kernel_source_for(variant: KernelVariant) -> String {
+    render_kernel_source_with(variant, ParamsBinding::Uniform)
+}
+
+/// The whole kernel as one WGSL module, in the given variant, with `Params` bound as `params`
+/// and the texels in one binding.
+pub fn render_kernel_source_with(variant: KernelVariant, params: ParamsBinding) -> String {
+    render_kernel_source_with_texels(variant, params, TexelBinding::One)
+}
+
+/// [`render_kernel_source_with`], reading texels as `texels` says (src/kernel/texels.rs).
+pub fn render_kernel_source_with_texels(
+    variant: KernelVariant,
+    params: ParamsBinding,
+    texels: TexelBinding,
+) -> String {
+    let (scene_name, scene_text) = variant.binding.part();
+    let (texels_name, texels_text) = texels.part();
+    let mut source = String::new();
+    // An extension must be enabled before any declaration.
+    if variant.binding.uses_ray_queries() {
+        source += "enable wgpu_ray_query;\n";
+    }
+    for (i, (name, text)) in SHADER_PARTS.iter().enumerate() {
+        source += &format!("// ---- {name}\n{text}\n");
+        if i == 0 {
+            source += &format!(
+                "// ---- params\n@group(0) @binding(0) var<{}> params: Params;\n",
+                params.address_space()
+            );
+            source += &format!("// ---- features\n{}\n", variant.features.part());
+            source += &format!("// ---- {scene_name}\n{scene_text}\n");
+            source += &format!("// ---- {texels_name}\n{texels_text}\n");
+        }
+    }
+    source
+}

@@ -1,0 +1,80 @@
+//! A render's per-pixel running statistics (mean and M2 over a count of samples), as the
+//! renderers keep them and as partial files store them, and the exact pairwise merge of two.
+
+use crate::image::output::Image;
+use crate::render::variance_of_mean;
+
+/// Per-pixel mean radiance and M2 (the sum of squared deviations from the mean) over `count`
+/// samples per pixel, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulation {
+    pub width: u32,
+    pub height: u32,
+    pub count: u32,
+    pub mean: Vec<[f32; 3]>,
+    pub m2: Vec<[f32; 3]>,
+}
+
+impl Accumulation {
+    /// No samples yet.
+    pub fn empty(width: u32, height: u32) -> Accumulation {
+        let pixels = width as usize * height as usize;
+        Accumulation {
+            width,
+            height,
+            count: 0,
+            mean: vec![[0.0; 3]; pixels],
+            m2: vec![[0.0; 3]; pixels],
+        }
+    }
+
+    /// Adds `other`'s samples with Chan, Golub and LeVeque's pairwise update, in the kernel's
+    /// f32 arithmetic and operation order (`shaders/integrator/trace.wgsl`, where a batch joins the
+    /// totals). So merging the statistics of consecutive sample ranges gives the same bits as
+    /// a render whose batches were those ranges. Both must have the same size.
+    pub fn merge(&mut self, other: &Accumulation) {
+        assert_eq!(
+            (self.width, self.height),
+            (other.width, other.height),
+            "merging accumulations of different sizes"
+        );
+        if other.count == 0 {
+            return;
+        }
+        let n_old = self.count as f32;
+        let n_new = other.count as f32;
+        let n = n_old + n_new;
+        let mean_weight = n_new / n;
+        let m2_weight = n_old * n_new / n;
+        for i in 0..self.mean.len() {
+            for c in 0..3 {
+                let old_mean = self.mean[i][c];
+                let delta = other.mean[i][c] - old_mean;
+                self.mean[i][c] = old_mean + delta * mean_weight;
+                self.m2[i][c] = self.m2[i][c] + other.m2[i][c] + delta * delta * m2_weight;
+            }
+        }
+        self.count += other.count;
+    }
+
+    pub fn mean_image(&self) -> Image {
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self.mean.clone(),
+        }
+    }
+
+    /// The variance of each pixel's mean estimate (σ²/n), as `--variance` writes it.
+    pub fn variance_image(&self) -> Image {
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self
+                .m2
+                .iter()
+                .map(|&m2| variance_of_mean(m2, self.count))
+                .collect(),
+        }
+    }
+}
