@@ -402,7 +402,7 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
     ctx.queue.submit([encoder.finish()]);
     ctx.wait_idle()
         .map_err(|e| e.context("building the acceleration structure"))?;
-    let references = super::renderer::storage_buffer(ctx, "hardware references", &references);
+    let references = super::upload::storage_buffer(ctx, "hardware references", &references);
     Ok(AccelerationStructure {
         tlas,
         references,

@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glint::gpu::binding::{bind_group, compute_layout_entries};
-use glint::gpu::renderer::storage_buffer;
+use glint::gpu::upload::storage_buffer;
 use glint::gpu::GpuContext;
 use glint::kernel::variant::{
     render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
