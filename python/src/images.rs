@@ -1,7 +1,8 @@
 //! Images between NumPy and glint: `glint.write`, `glint.read` and `glint.compare`.
 
 use glint::image::compare::{compare as compare_images, Z_TEST_ALPHA};
-use glint::image::output::{check_output_path, Image, ImageFormat};
+use glint::image::format::ImageFormat;
+use glint::image::output::{check_output_path, Image};
 use glint::image::tonemap::{DisplayTransform, Tonemap};
 use numpy::ndarray::{Array3, Axis};
 use numpy::{IntoPyArray, PyArray3, PyReadonlyArrayDyn, PyUntypedArrayMethods};

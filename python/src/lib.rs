@@ -4,6 +4,7 @@
 //! a render's pixels become the array without a copy.
 
 mod dict_toml;
+mod gpu_cache;
 mod images;
 mod render;
 mod scene;

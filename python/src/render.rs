@@ -2,6 +2,7 @@
 //! bytes) on the device asked for, with the GIL released, Ctrl-C checked between batches, and
 //! one GPU device per process.
 
+use crate::gpu_cache::{gpu_context, same_objects, GpuCache};
 use crate::images::to_numpy;
 use crate::scene::Scene;
 use crate::SceneError;
@@ -17,48 +18,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Mutex, OnceLock};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// The CLI's batch duration (src/cli/render.rs): also how long Ctrl-C may wait.
 const BATCH_TARGET: Duration = Duration::from_millis(250);
-
-/// The process's GPU, opened by the first render that wants one and kept: opening a Vulkan
-/// device takes longer than a small render.
-static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
-
-fn gpu_context() -> Result<&'static GpuContext, &'static str> {
-    GPU.get_or_init(|| GpuContext::new().map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(String::as_str)
-}
-
-/// A scene's GPU renderer with its compiled kernel, reused by the next render of the scene
-/// when only the camera and the per-render settings differ (`same_objects`).
-pub struct GpuCache {
-    /// The scene the renderer was made for (its objects, image size and features).
-    scene: scenes::Scene,
-    /// Whether its kernel accumulates AOVs.
-    aovs: bool,
-    traversal: Traversal,
-    renderer: GpuRenderer<'static>,
-}
-
-/// Whether a renderer made for `a` renders `b` once given `b`'s parameters: everything but
-/// the camera, spp, seed, max_bounces, the background and light sampling (all in `Params`)
-/// is the same.
-fn same_objects(a: &scenes::Scene, b: &scenes::Scene) -> bool {
-    a.render.width == b.render.width
-        && a.render.height == b.render.height
-        && a.render.russian_roulette == b.render.russian_roulette
-        && a.materials == b.materials
-        && a.spheres == b.spheres
-        && a.quads == b.quads
-        && a.lights == b.lights
-        && a.environment == b.environment
-        && a.textures == b.textures
-        && a.triangles == b.triangles
-}
 
 /// `--traversal`'s values.
 fn parse_traversal(s: &str) -> PyResult<TraversalChoice> {

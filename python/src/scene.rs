@@ -1,7 +1,7 @@
 //! `glint.load`, `glint.load_string`, `glint.load_dict` and the `Scene` they return.
 
 use crate::dict_toml::{from_toml_text, to_toml_text};
-use crate::render::GpuCache;
+use crate::gpu_cache::GpuCache;
 use crate::SceneError;
 use glint::input_file::{read_regular_file, SCENE_FILE_LIMIT};
 use glint::scene;

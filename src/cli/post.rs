@@ -4,7 +4,8 @@
 use super::tone::ToneArgs;
 use crate::error::InputError;
 use crate::image::denoise;
-use crate::image::output::{Image, ImageFormat};
+use crate::image::format::ImageFormat;
+use crate::image::output::Image;
 use crate::image::output_check::OutputSet;
 use crate::image::tonemap::DisplayTransform;
 use crate::kernel::types::Params;

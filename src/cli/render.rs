@@ -7,7 +7,7 @@ use super::sample_range::{self, SampleRangeArgs};
 use crate::cpu::integrator::renderer::CpuRenderer;
 use crate::error::InputError;
 use crate::gpu::{GpuContext, GpuRenderer, TraversalChoice};
-use crate::image::output::ImageFormat;
+use crate::image::format::ImageFormat;
 use crate::image::output_check::OutputSet;
 use crate::kernel::types::Params;
 use crate::kernel::KernelScene;

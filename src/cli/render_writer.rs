@@ -4,7 +4,8 @@
 //! next checkpoint; only a failed final write is an error. With --denoise the image goes to
 //! --raw (or nowhere), as `-o` is then the denoised image (src/cli/post.rs).
 
-use crate::image::output::{Image, ImageFormat};
+use crate::image::format::ImageFormat;
+use crate::image::output::Image;
 use crate::image::tonemap::DisplayTransform;
 use crate::render::partial::{Partial, PartialInfo};
 use crate::render::Renderer;

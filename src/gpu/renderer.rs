@@ -21,9 +21,10 @@ use crate::kernel::variant::{
     RENDER_ENTRY_POINT, WORKGROUP_SIZE,
 };
 use crate::kernel::KernelScene;
+use crate::render::accumulation::variance_of_mean;
 use crate::render::accumulation::Accumulation;
 use crate::render::aov::Aovs;
-use crate::render::{check_size, variance_of_mean, Renderer};
+use crate::render::{check_size, Renderer};
 use anyhow::{anyhow, Result};
 use wgpu::util::DeviceExt;
 

@@ -5,6 +5,7 @@
 pub mod atomic_write;
 pub mod compare;
 pub mod denoise;
+pub mod format;
 pub mod output;
 pub mod output_check;
 pub mod tonemap;

@@ -2,6 +2,7 @@
 //! Every write is atomic: a temporary file in the same folder, then a rename.
 
 use crate::image::atomic_write::write_atomically;
+use crate::image::format::ImageFormat;
 use crate::input_file::{read_regular_file, IMAGE_FILE_LIMIT};
 use anyhow::{Context, Result};
 use image::{ImageBuffer, ImageResult, Rgb, Rgb32FImage};
@@ -14,31 +15,6 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub pixels: Vec<[f32; 3]>,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ImageFormat {
-    /// Clamped to [0, 1], sRGB-encoded, 8 bits.
-    Png,
-    /// Linear float32 RGB, unclamped.
-    Exr,
-}
-
-impl ImageFormat {
-    /// The format an output path asks for, by its extension.
-    pub fn from_path(path: &Path) -> Result<ImageFormat, String> {
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase());
-        match ext.as_deref() {
-            Some("png") => Ok(ImageFormat::Png),
-            Some("exr") => Ok(ImageFormat::Exr),
-            _ => Err(format!(
-                "{}: unknown image format; use a .png or .exr file name",
-                path.display()
-            )),
-        }
-    }
 }
 
 /// A path an image can be written to: a known format, in a folder where files can be created.

@@ -25,7 +25,7 @@
 //!   links count too.
 
 use crate::error::InputError;
-use crate::image::output::ImageFormat;
+use crate::image::format::ImageFormat;
 use std::fs::Metadata;
 use std::io;
 use std::path::{Path, PathBuf};

@@ -2,7 +2,6 @@
 //! renderers keep them and as partial files store them, and the exact pairwise merge of two.
 
 use crate::image::output::Image;
-use crate::render::variance_of_mean;
 
 /// Per-pixel mean radiance and M2 (the sum of squared deviations from the mean) over `count`
 /// samples per pixel, row 0 at the top.
@@ -77,4 +76,13 @@ impl Accumulation {
                 .collect(),
         }
     }
+}
+
+/// σ²/n per channel from M2 over n samples: M2 / (n − 1) / n.
+pub fn variance_of_mean(m2: [f32; 3], n: u32) -> [f32; 3] {
+    if n < 2 {
+        return [0.0; 3];
+    }
+    let scale = 1.0 / ((n as f64 - 1.0) * n as f64);
+    m2.map(|v| (v.max(0.0) as f64 * scale) as f32)
 }

@@ -82,15 +82,6 @@ pub fn check_size(params: &crate::kernel::types::Params, state: &Accumulation) -
     Ok(())
 }
 
-/// σ²/n per channel from M2 over n samples: M2 / (n − 1) / n.
-pub fn variance_of_mean(m2: [f32; 3], n: u32) -> [f32; 3] {
-    if n < 2 {
-        return [0.0; 3];
-    }
-    let scale = 1.0 / ((n as f64 - 1.0) * n as f64);
-    m2.map(|v| (v.max(0.0) as f64 * scale) as f32)
-}
-
 /// Picks the next batch's samples per pixel from the last batch's duration.
 #[derive(Clone, Debug)]
 pub struct BatchSizer {

@@ -358,8 +358,8 @@ fn text_attribute(attributes: &HashMap<Text, AttributeValue>, key: &str) -> Opti
 /// Writes a render's image to `path`: a partial file (mean, M2 and header) for `.exr`, so it
 /// can be resumed or merged, and the mean in the file's own format otherwise (`.png`).
 pub fn write_image(path: &Path, partial: &Partial) -> Result<()> {
-    match crate::image::output::ImageFormat::from_path(path).map_err(anyhow::Error::msg)? {
-        crate::image::output::ImageFormat::Exr => partial.write(path),
+    match crate::image::format::ImageFormat::from_path(path).map_err(anyhow::Error::msg)? {
+        crate::image::format::ImageFormat::Exr => partial.write(path),
         _ => partial.accumulation.mean_image().write(path),
     }
 }

@@ -502,8 +502,8 @@ fn item14_a_full_disk_says_so_not_decoding() {
         pixels: vec![[0.5; 3]; 64 * 64],
     };
     for format in [
-        glint::image::output::ImageFormat::Exr,
-        glint::image::output::ImageFormat::Png,
+        glint::image::format::ImageFormat::Exr,
+        glint::image::format::ImageFormat::Png,
     ] {
         let e = glint::image::atomic_write::encode_into(&full, Path::new("x"), |w| {
             image.encode(format, w)

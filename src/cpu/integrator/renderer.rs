@@ -3,9 +3,10 @@
 use crate::cpu::integrator::trace::{render_pixel, PixelStats, SceneRefs};
 use crate::image::output::Image;
 use crate::kernel::KernelScene;
+use crate::render::accumulation::variance_of_mean;
 use crate::render::accumulation::Accumulation;
 use crate::render::aov::Aovs;
-use crate::render::{check_size, variance_of_mean, Renderer};
+use crate::render::{check_size, Renderer};
 use anyhow::{anyhow, Result};
 use rayon::prelude::*;
 
