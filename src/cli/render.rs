@@ -18,7 +18,7 @@ use crate::render::{
 };
 use crate::scene::model::ModelScene;
 use crate::scene::model_toml::model_toml;
-use crate::scene::{RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -145,8 +145,30 @@ fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
     }
 }
 
-pub fn run(args: RenderArgs) -> Result<()> {
-    let started = Instant::now();
+/// The GPU renderer where there is a GPU (with the traversal `--traversal` resolves to), the
+/// CPU reference otherwise.
+fn make_renderer<'g>(
+    args: &RenderArgs,
+    gpu: Option<&'g GpuContext>,
+    kernel_scene: &KernelScene,
+) -> Result<(Box<dyn Renderer + 'g>, Option<crate::gpu::Traversal>)> {
+    // The CPU reference traverses its BVH whatever --traversal says.
+    let traversal = match gpu {
+        Some(ctx) => Some(args.traversal.resolve(ctx)?),
+        None => None,
+    };
+    let renderer: Box<dyn Renderer + 'g> = match (gpu, traversal) {
+        (Some(ctx), Some(traversal)) => {
+            Box::new(GpuRenderer::with_traversal(ctx, kernel_scene, traversal)?)
+        }
+        _ => Box::new(CpuRenderer::new(kernel_scene)),
+    };
+    Ok((renderer, traversal))
+}
+
+/// The scene `args` ask for, with their overrides; `None` where `--print-scene` printed it
+/// instead.
+fn scene_to_render(args: &RenderArgs) -> Result<Option<Scene>> {
     let (scene, model) = args.model.load(&args.scene, args.width, args.height)?;
     let overrides = RenderOverrides {
         width: args.width,
@@ -169,8 +191,86 @@ pub fn run(args: RenderArgs) -> Result<()> {
             .into());
         };
         crate::outln!("{}", model_toml(&ModelScene { scene, ..model }).trim_end());
-        return Ok(());
+        return Ok(None);
     }
+    Ok(Some(scene))
+}
+
+/// A progress bar on a terminal, hidden elsewhere.
+fn progress_bar(samples: u64) -> ProgressBar {
+    let progress = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(samples), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    progress.set_style(
+        ProgressStyle::with_template("{bar:40.cyan/blue} {pos}/{len} spp  {msg}  ETA {eta}")
+            .expect("valid template"),
+    );
+    progress
+}
+
+/// What `--json` reports of a finished render, beside the arguments and the renderer.
+struct FinishedRun<'a> {
+    scene: &'a Scene,
+    kernel_scene: &'a KernelScene,
+    output: &'a std::path::Path,
+    stats: &'a crate::render::RenderStats,
+    /// Samples per pixel of a resumed file, not rendered by this run.
+    resumed: u32,
+    relative_error: Option<f64>,
+    denoise_seconds: Option<f64>,
+    traversal: Option<crate::gpu::Traversal>,
+}
+
+/// `--json`'s one line about a finished render.
+fn json_summary(
+    args: &RenderArgs,
+    run: &FinishedRun,
+    renderer: &dyn Renderer,
+    started: Instant,
+) -> serde_json::Value {
+    let seconds = run.stats.render_time.as_secs_f64();
+    // This run's paths only, not a resumed file's.
+    let paths = (run.scene.render.width as u64 * run.scene.render.height as u64)
+        * (run.stats.spp - run.resumed) as u64;
+    serde_json::json!({
+        "scene": args.scene.display().to_string(),
+        "output": run.output.display().to_string(),
+        "width": run.scene.render.width,
+        "height": run.scene.render.height,
+        "spp": run.stats.spp,
+        "max_bounces": run.scene.render.max_bounces,
+        "seed": run.scene.render.seed,
+        "paths": paths,
+        "seconds": seconds,
+        "paths_per_second": paths as f64 / seconds.max(1e-9),
+        "wall_seconds": started.elapsed().as_secs_f64(),
+        "stopped_by": run.stats.stop_reason.as_str(),
+        // Below 2 spp there is no variance estimate: the error is unknown (null), not 0.
+        "relative_error": run.relative_error,
+        "nonfinite_samples": renderer.nonfinite_samples(),
+        "device": renderer.device_name(),
+        "backend": renderer.backend_name(),
+        // The GPU's traversal; the CPU reference's is its BVH ("software").
+        "traversal": run.traversal.unwrap_or(crate::gpu::Traversal::Software).name(),
+        // Stored (an instanced mesh once), then placed (once per instance).
+        "triangles": run.kernel_scene.triangles.len(),
+        "instances": run.kernel_scene.instances.len(),
+        "placed_triangles": run.scene.placed_triangle_count(),
+        "bvh_nodes": run.kernel_scene.bvh_nodes.len(),
+        "bvh_build_seconds": run.kernel_scene.bvh_build_seconds,
+        "scene_bytes": run.kernel_scene.scene_bytes(),
+        "denoise_seconds": run.denoise_seconds,
+        "samples": [renderer.first_sample(), renderer.first_sample() + run.stats.spp],
+    })
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let started = Instant::now();
+    let Some(scene) = scene_to_render(&args)? else {
+        return Ok(());
+    };
     let range = &args.range;
     args.post.refuse_partial(
         range.samples.is_some() || range.shard.is_some() || range.resume.is_some(),
@@ -211,17 +311,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     args.post.check()?;
 
     let gpu = open_gpu(&args)?;
-    // The CPU reference traverses its BVH whatever --traversal says.
-    let traversal = match &gpu {
-        Some(ctx) => Some(args.traversal.resolve(ctx)?),
-        None => None,
-    };
-    let mut renderer: Box<dyn Renderer + '_> = match (&gpu, traversal) {
-        (Some(ctx), Some(traversal)) => {
-            Box::new(GpuRenderer::with_traversal(ctx, &kernel_scene, traversal)?)
-        }
-        _ => Box::new(CpuRenderer::new(&kernel_scene)),
-    };
+    let (mut renderer, traversal) = make_renderer(&args, gpu.as_ref(), &kernel_scene)?;
 
     plan.start(renderer.as_mut())?;
     // With --denoise, -o is the denoised image, written at the end; the mean goes to --raw.
@@ -244,18 +334,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             device: renderer.device_name(),
         },
     );
-    let progress = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(
-            Some(plan.samples_wanted() as u64),
-            ProgressDrawTarget::stderr(),
-        )
-    } else {
-        ProgressBar::hidden()
-    };
-    progress.set_style(
-        ProgressStyle::with_template("{bar:40.cyan/blue} {pos}/{len} spp  {msg}  ETA {eta}")
-            .expect("valid template"),
-    );
+    let progress = progress_bar(plan.samples_wanted() as u64);
     let pixels = width as f64 * height as f64;
     let mut last_checkpoint = Instant::now();
     let mut sizer = BatchSizer::new(BATCH_TARGET);
@@ -304,41 +383,19 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     if args.json {
-        let seconds = stats.render_time.as_secs_f64();
-        // This run's paths only, not a resumed file's.
-        let resumed = plan.resumed.as_ref().map_or(0, |p| p.accumulation.count);
-        let paths = pixels as u64 * (stats.spp - resumed) as u64;
-        let summary = serde_json::json!({
-            "scene": args.scene.display().to_string(),
-            "output": output.display().to_string(),
-            "width": width,
-            "height": height,
-            "spp": stats.spp,
-            "max_bounces": settings.max_bounces,
-            "seed": settings.seed,
-            "paths": paths,
-            "seconds": seconds,
-            "paths_per_second": paths as f64 / seconds.max(1e-9),
-            "wall_seconds": started.elapsed().as_secs_f64(),
-            "stopped_by": stats.stop_reason.as_str(),
-            // Below 2 spp there is no variance estimate: the error is unknown (null), not 0.
-            "relative_error": (stats.spp >= 2).then(|| relative_error(&mean, &variance)).flatten(),
-            "nonfinite_samples": renderer.nonfinite_samples(),
-            "device": renderer.device_name(),
-            "backend": renderer.backend_name(),
-            // The GPU's traversal; the CPU reference's is its BVH ("software").
-            "traversal": traversal.unwrap_or(crate::gpu::Traversal::Software).name(),
-            // Stored (an instanced mesh once), then placed (once per instance).
-            "triangles": kernel_scene.triangles.len(),
-            "instances": kernel_scene.instances.len(),
-            "placed_triangles": scene.placed_triangle_count(),
-            "bvh_nodes": kernel_scene.bvh_nodes.len(),
-            "bvh_build_seconds": kernel_scene.bvh_build_seconds,
-            "scene_bytes": kernel_scene.scene_bytes(),
-            "denoise_seconds": denoise_seconds,
-            "samples": [first, first + stats.spp],
-        });
-        crate::outln!("{summary}");
+        let run = FinishedRun {
+            scene: &scene,
+            kernel_scene: &kernel_scene,
+            output: &output,
+            stats: &stats,
+            resumed: plan.resumed.as_ref().map_or(0, |p| p.accumulation.count),
+            relative_error: (stats.spp >= 2)
+                .then(|| relative_error(&mean, &variance))
+                .flatten(),
+            denoise_seconds,
+            traversal,
+        };
+        crate::outln!("{}", json_summary(&args, &run, renderer.as_ref(), started));
     }
     if let Some(signal) = interrupt::requested() {
         return Err(Interrupted {
