@@ -12,7 +12,7 @@
 //! values are never inlined. Elsewhere they stay in a uniform buffer, which llvmpipe loads
 //! faster (the plain Cornell box was ~10% slower on Mesa 25 with them in storage).
 
-use crate::kernel::variant::ParamsBinding;
+use crate::kernel::source::ParamsBinding;
 
 /// The binding of the kernel's `Params` for a device: storage where the driver would recompile
 /// the kernel at every dispatch.

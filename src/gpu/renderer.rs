@@ -14,12 +14,12 @@ use super::tiles::{next_tile, TilePlanner};
 use super::traversal::Traversal;
 use super::upload::{check_storage_binding_count, ImageSizes, SceneBuffers};
 use crate::image::output::Image;
+use crate::kernel::source::{
+    render_kernel_source_with_texels, ParamsBinding, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
+};
 use crate::kernel::texels::TexelBinding;
 use crate::kernel::types::Params;
-use crate::kernel::variant::{
-    render_kernel_source_with_texels, KernelFeatures, KernelVariant, ParamsBinding, SceneBinding,
-    RENDER_ENTRY_POINT, WORKGROUP_SIZE,
-};
+use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
 use crate::render::accumulation::Accumulation;

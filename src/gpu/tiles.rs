@@ -5,7 +5,7 @@
 
 use std::time::Duration;
 
-/// Tiles are whole workgroups (8×8 pixels, `crate::kernel::variant::WORKGROUP_SIZE`), except at the
+/// Tiles are whole workgroups (8×8 pixels, `crate::kernel::source::WORKGROUP_SIZE`), except at the
 /// image's right and bottom edges.
 const GRANULE: u32 = 8;
 

@@ -7,6 +7,7 @@
 pub mod bvh;
 mod emitters;
 pub mod scene;
+pub mod source;
 pub mod texels;
 pub mod types;
 pub mod variant;

@@ -3,17 +3,17 @@
 //! size, that the uniform arrays are as large as what the host uploads, and that the texel
 //! windows' bindings (29–31) are the host's. So the host and the kernel cannot drift apart.
 
+use glint::kernel::source::{
+    render_kernel_source, render_kernel_source_for, render_kernel_source_with_texels,
+    ParamsBinding, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
+};
 use glint::kernel::texels::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use glint::kernel::types::{
     BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
     Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
     TriangleUvs,
 };
-use glint::kernel::variant::{
-    render_kernel_source, render_kernel_source_for, render_kernel_source_with_texels,
-    KernelFeatures, KernelVariant, ParamsBinding, SceneBinding, SceneCounts, RENDER_ENTRY_POINT,
-    WORKGROUP_SIZE,
-};
+use glint::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding, SceneCounts};
 use naga::proc::Layouter;
 use std::mem::{offset_of, size_of};
 

@@ -4,9 +4,8 @@ use bytemuck::{Pod, Zeroable};
 use glint::gpu::binding::{bind_group, compute_layout_entries};
 use glint::gpu::upload::storage_buffer;
 use glint::gpu::GpuContext;
-use glint::kernel::variant::{
-    render_kernel_source, render_kernel_source_for, KernelFeatures, KernelVariant, SceneBinding,
-};
+use glint::kernel::source::{render_kernel_source, render_kernel_source_for};
+use glint::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 use glint::kernel::KernelScene;
 use wgpu::util::DeviceExt;
 
