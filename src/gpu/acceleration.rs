@@ -250,28 +250,8 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
     let device = &ctx.device;
     let limits = device.limits();
     let geometry = HardwareGeometry::of(scene);
+    check_primitive_counts(ctx, &geometry)?;
     let triangles = geometry.triangle_references.len();
-    let boxes = geometry.boxes.len();
-    let most = limits.max_blas_primitive_count as usize;
-    let largest_mesh = geometry
-        .meshes
-        .iter()
-        .map(|m| m.triangle_references.len())
-        .max()
-        .unwrap_or(0);
-    for (count, what) in [
-        (triangles, "triangles"),
-        (boxes, "spheres and quads"),
-        (largest_mesh, "triangles of one instanced mesh"),
-    ] {
-        if count > most {
-            return Err(anyhow!(
-                "the scene's {count} {what} are more than {} allows in one acceleration structure \
-                 ({most}); use --traversal software",
-                ctx.device_name()
-            ));
-        }
-    }
     let references = geometry.references();
     if references.len() > MAX_CUSTOM_DATA {
         return Err(anyhow!(
@@ -323,26 +303,8 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
         ));
     }
     let flags = wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE;
-    let blas_descriptor = wgpu::CreateBlasDescriptor {
-        label: Some("glint BLAS"),
-        flags,
-        update_mode: wgpu::AccelerationStructureUpdateMode::Build,
-    };
     let sizes: Vec<BlasSize> = blas_inputs.iter().map(|(input, _)| input.size()).collect();
-    let blases: Vec<wgpu::Blas> = sizes
-        .iter()
-        .map(|size| {
-            let descriptors = match size {
-                BlasSize::Triangles(s) => wgpu::BlasGeometrySizeDescriptors::Triangles {
-                    descriptors: vec![s.clone()],
-                },
-                BlasSize::Boxes(s) => wgpu::BlasGeometrySizeDescriptors::AABBs {
-                    descriptors: vec![s.clone()],
-                },
-            };
-            device.create_blas(&blas_descriptor, descriptors)
-        })
-        .collect();
+    let blases = create_blases(device, &sizes);
     let inputs: Vec<wgpu::Buffer> = blas_inputs
         .iter()
         .map(|(input, _)| {
@@ -368,7 +330,79 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
             0xff,
         ));
     }
-    let entries: Vec<_> = sizes
+    let entries = blas_build_entries(&sizes, &blases, &inputs);
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.build_acceleration_structures(entries.iter(), std::iter::once(&tlas));
+    ctx.queue.submit([encoder.finish()]);
+    ctx.wait_idle()
+        .map_err(|e| e.context("building the acceleration structure"))?;
+    let references = super::upload::storage_buffer(ctx, "hardware references", &references);
+    Ok(AccelerationStructure {
+        tlas,
+        references,
+        _blases: blases,
+        _inputs: inputs,
+        build_seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// Refuses a scene with more primitives in one structure than the device allows.
+fn check_primitive_counts(ctx: &GpuContext, geometry: &HardwareGeometry) -> Result<()> {
+    let triangles = geometry.triangle_references.len();
+    let boxes = geometry.boxes.len();
+    let most = ctx.device.limits().max_blas_primitive_count as usize;
+    let largest_mesh = geometry
+        .meshes
+        .iter()
+        .map(|m| m.triangle_references.len())
+        .max()
+        .unwrap_or(0);
+    for (count, what) in [
+        (triangles, "triangles"),
+        (boxes, "spheres and quads"),
+        (largest_mesh, "triangles of one instanced mesh"),
+    ] {
+        if count > most {
+            return Err(anyhow!(
+                "the scene's {count} {what} are more than {} allows in one acceleration structure \
+                 ({most}); use --traversal software",
+                ctx.device_name()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// One empty BLAS per size, for the build to fill.
+fn create_blases(device: &wgpu::Device, sizes: &[BlasSize]) -> Vec<wgpu::Blas> {
+    let blas_descriptor = wgpu::CreateBlasDescriptor {
+        label: Some("glint BLAS"),
+        flags: wgpu::AccelerationStructureFlags::PREFER_FAST_TRACE,
+        update_mode: wgpu::AccelerationStructureUpdateMode::Build,
+    };
+    sizes
+        .iter()
+        .map(|size| {
+            let descriptors = match size {
+                BlasSize::Triangles(s) => wgpu::BlasGeometrySizeDescriptors::Triangles {
+                    descriptors: vec![s.clone()],
+                },
+                BlasSize::Boxes(s) => wgpu::BlasGeometrySizeDescriptors::AABBs {
+                    descriptors: vec![s.clone()],
+                },
+            };
+            device.create_blas(&blas_descriptor, descriptors)
+        })
+        .collect()
+}
+
+/// What the build writes into each BLAS: its triangles' vertices or its boxes.
+fn blas_build_entries<'a>(
+    sizes: &'a [BlasSize],
+    blases: &'a [wgpu::Blas],
+    inputs: &'a [wgpu::Buffer],
+) -> Vec<wgpu::BlasBuildEntry<'a>> {
+    sizes
         .iter()
         .enumerate()
         .map(|(i, size)| wgpu::BlasBuildEntry {
@@ -396,20 +430,7 @@ pub fn build(ctx: &GpuContext, scene: &KernelScene) -> Result<AccelerationStruct
                 }
             },
         })
-        .collect();
-    let mut encoder = device.create_command_encoder(&Default::default());
-    encoder.build_acceleration_structures(entries.iter(), std::iter::once(&tlas));
-    ctx.queue.submit([encoder.finish()]);
-    ctx.wait_idle()
-        .map_err(|e| e.context("building the acceleration structure"))?;
-    let references = super::upload::storage_buffer(ctx, "hardware references", &references);
-    Ok(AccelerationStructure {
-        tlas,
-        references,
-        _blases: blases,
-        _inputs: inputs,
-        build_seconds: started.elapsed().as_secs_f64(),
-    })
+        .collect()
 }
 
 #[cfg(test)]
