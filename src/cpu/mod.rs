@@ -4,12 +4,13 @@
 //!
 //! From the bottom up: `core` (rays, random numbers, frames, the camera), `geometry`
 //! (intersections and surfaces), `traverse` (the BVHs), `textures`, `materials` (the BSDFs),
-//! `lights` (light sampling), `integrator` (the path tracer and the renderer).
+//! `scene_refs` (the scene as the kernel binds it), `lights` (light sampling), `integrator` (the path tracer and the renderer).
 
 pub mod core;
 pub mod geometry;
 pub mod integrator;
 pub mod lights;
 pub mod materials;
+pub mod scene_refs;
 pub mod textures;
 pub mod traverse;

@@ -7,7 +7,7 @@ use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 37] = [
+pub const SHADER_PARTS: [(&str, &str); 41] = [
     (
         "core/types.wgsl",
         include_str!("../../shaders/core/types.wgsl"),
@@ -16,6 +16,10 @@ pub const SHADER_PARTS: [(&str, &str); 37] = [
     (
         "core/camera.wgsl",
         include_str!("../../shaders/core/camera.wgsl"),
+    ),
+    (
+        "geometry/hit.wgsl",
+        include_str!("../../shaders/geometry/hit.wgsl"),
     ),
     (
         "geometry/surface.wgsl",
@@ -32,6 +36,10 @@ pub const SHADER_PARTS: [(&str, &str); 37] = [
     (
         "geometry/intersect.wgsl",
         include_str!("../../shaders/geometry/intersect.wgsl"),
+    ),
+    (
+        "traverse/bvh_ray.wgsl",
+        include_str!("../../shaders/traverse/bvh_ray.wgsl"),
     ),
     (
         "traverse/bvh.wgsl",
@@ -76,6 +84,10 @@ pub const SHADER_PARTS: [(&str, &str); 37] = [
     (
         "materials/dielectric_energy.wgsl",
         include_str!("../../shaders/materials/dielectric_energy.wgsl"),
+    ),
+    (
+        "materials/rough_dielectric_single.wgsl",
+        include_str!("../../shaders/materials/rough_dielectric_single.wgsl"),
     ),
     (
         "materials/rough_dielectric.wgsl",
@@ -128,6 +140,10 @@ pub const SHADER_PARTS: [(&str, &str); 37] = [
     (
         "integrator/volume.wgsl",
         include_str!("../../shaders/integrator/volume.wgsl"),
+    ),
+    (
+        "lights/light_sample.wgsl",
+        include_str!("../../shaders/lights/light_sample.wgsl"),
     ),
     (
         "lights/sampling.wgsl",

@@ -19,7 +19,7 @@
 //! the cores. The same numbers feed the GPU (binding 33) and the CPU reference.
 
 use crate::cpu::materials::dielectric::fresnel_dielectric;
-use crate::cpu::materials::rough_dielectric::single_scattering_albedo_sample;
+use crate::cpu::materials::rough_dielectric_single::single_scattering_albedo_sample;
 use crate::scene::limits::MAX_IOR;
 use crate::tables::threads::rows_in_parallel;
 use glam::Vec3;

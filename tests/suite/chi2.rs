@@ -363,7 +363,7 @@ fn check_light_samples(name: &str, scene: &glint::scene::Scene, p: Vec3, samples
 fn cpu_light_sampling() {
     for (k, (name, scene, p)) in light_cases().into_iter().enumerate() {
         let kernel = scene.kernel_scene();
-        let refs = glint::cpu::integrator::trace::SceneRefs::of(&kernel, &kernel.params);
+        let refs = glint::cpu::scene_refs::SceneRefs::of(&kernel, &kernel.params);
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 21 + k as u32);
@@ -493,7 +493,7 @@ fn check_emitter_choices(name: &str, scene: &glint::scene::Scene, picks: &[[f32;
 }
 
 fn cpu_emitter_choices(scene: &glint::kernel::KernelScene, seed: u32) -> Vec<[f32; 4]> {
-    let refs = glint::cpu::integrator::trace::SceneRefs::of(scene, &scene.params);
+    let refs = glint::cpu::scene_refs::SceneRefs::of(scene, &scene.params);
     (0..SAMPLES)
         .map(|i| {
             let mut r = cpu_draws(i, seed);
@@ -948,7 +948,7 @@ fn cpu_environment_sampling() {
     let dir = tempfile::tempdir().unwrap();
     for (k, case) in map_cases().iter().enumerate() {
         let kernel = environment_scene(case, dir.path()).kernel_scene();
-        let refs = glint::cpu::integrator::trace::SceneRefs::of(&kernel, &kernel.params);
+        let refs = glint::cpu::scene_refs::SceneRefs::of(&kernel, &kernel.params);
         let samples: Vec<[f32; 4]> = (0..SAMPLES)
             .map(|i| {
                 let mut r = cpu_draws(i, SEED + 101 + k as u32);
@@ -1034,7 +1034,7 @@ fn check_sun_samples(name: &str, samples: &[[f32; 4]]) {
 #[test]
 fn cpu_sun_disk_sampling() {
     let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
-    let refs = glint::cpu::integrator::trace::SceneRefs::of(&kernel, &kernel.params);
+    let refs = glint::cpu::scene_refs::SceneRefs::of(&kernel, &kernel.params);
     let samples: Vec<[f32; 4]> = (0..SAMPLES)
         .map(|i| {
             let mut r = cpu_draws(i, SEED + 51);

@@ -11,11 +11,12 @@ use common::{gpu, gpu_with_ray_queries};
 use glam::Vec3;
 use glint::cpu::core::ray::Ray;
 use glint::cpu::core::rng::Rng;
+use glint::cpu::geometry::hit::{ClosestPrimitive, NO_HIT};
 use glint::cpu::geometry::intersect::{
-    closest_primitive, escapes, first_hit_is, scan_closest_primitive, ClosestPrimitive, Geometry,
-    NO_HIT,
+    closest_primitive, escapes, first_hit_is, scan_closest_primitive,
 };
-use glint::cpu::integrator::trace::SceneRefs;
+use glint::cpu::geometry::scene_geometry::Geometry;
+use glint::cpu::scene_refs::SceneRefs;
 use glint::kernel::bvh;
 use glint::kernel::types::{PRIMITIVE_QUAD, PRIMITIVE_SPHERE};
 use glint::kernel::KernelScene;

@@ -83,7 +83,7 @@ fn cornell_with_block(copies: bool, size: u32, seed: u32) -> KernelScene {
 fn with_copies_in_the_tree(scene: &KernelScene) -> KernelScene {
     let tree = bvh::build_with_copies(&scene.spheres, &scene.quads, &scene.triangles).unwrap();
     assert!(
-        tree.depth <= glint::cpu::traverse::bvh::BVH_STACK_SIZE,
+        tree.depth <= glint::kernel::bvh::BVH_STACK_SIZE,
         "{}",
         tree.depth
     );

@@ -8,7 +8,7 @@
 use crate::common;
 use common::probe::{run_probe_hardware, ProbeParams};
 use common::{gpu_with_ray_queries, render_cpu, PathAgreement, MESH_SCENE_HEADER};
-use glint::cpu::geometry::intersect::NO_HIT;
+use glint::cpu::geometry::hit::NO_HIT;
 use glint::gpu::{GpuRenderer, Traversal};
 use glint::render::{render_image, Renderer};
 use glint::scene::stress::StressMesh;

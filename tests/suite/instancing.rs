@@ -15,11 +15,13 @@ use common::{gpu, render_cpu, render_gpu, MESH_SCENE_HEADER};
 use glam::{Mat4, Vec3};
 use glint::cpu::core::ray::Ray;
 use glint::cpu::core::rng::Rng;
+use glint::cpu::geometry::hit::NO_HIT;
 use glint::cpu::geometry::instance::transform_point;
 use glint::cpu::geometry::intersect::{
-    closest_primitive, escapes, first_hit_is, scan_closest_primitive, Geometry, NO_HIT,
+    closest_primitive, escapes, first_hit_is, scan_closest_primitive,
 };
-use glint::cpu::integrator::trace::SceneRefs;
+use glint::cpu::geometry::scene_geometry::Geometry;
+use glint::cpu::scene_refs::SceneRefs;
 use glint::kernel::types::{NO_INSTANCE, PRIMITIVE_QUAD};
 use glint::kernel::KernelScene;
 use glint::scene::stress::StressMesh;

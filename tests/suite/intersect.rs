@@ -4,9 +4,9 @@
 
 use glam::Vec3;
 use glint::cpu::core::ray::Ray;
-use glint::cpu::geometry::intersect::{
-    closest_primitive, first_hit_is, hit_quad, hit_sphere, intersect_scene, Geometry, NO_HIT,
-};
+use glint::cpu::geometry::hit::{hit_quad, hit_sphere, NO_HIT};
+use glint::cpu::geometry::intersect::{closest_primitive, first_hit_is, intersect_scene};
+use glint::cpu::geometry::scene_geometry::Geometry;
 use glint::cpu::geometry::surface::{offset_ray_origin, sphere_point};
 use glint::kernel::types::{Quad, Sphere};
 use glint::scene::{Material, MaterialKind, Quad as SceneQuad, Scene};

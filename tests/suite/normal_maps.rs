@@ -128,7 +128,7 @@ const EYE: Vec3 = Vec3::new(0.0, 0.0, 5.0);
 /// The shading normals the CPU finds along the probe's rays.
 fn cpu_normals(scene: &glint::kernel::KernelScene) -> Vec<[f32; 4]> {
     use glint::cpu::geometry::intersect::intersect_scene;
-    use glint::cpu::integrator::trace::SceneRefs;
+    use glint::cpu::scene_refs::SceneRefs;
     use glint::cpu::textures::normal_map::normal_mapped;
     use glint::cpu::textures::texture::material_at;
     let refs = SceneRefs::of(scene, &scene.params);

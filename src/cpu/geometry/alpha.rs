@@ -7,7 +7,7 @@
 //! rays all see the same holes. Spheres and quads are always opaque.
 
 use crate::cpu::core::rng::{pcg_hash, rng_init};
-use crate::cpu::geometry::intersect::NO_HIT;
+use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::geometry::triangle::{hit_triangle, triangle_barycentrics, TriangleRay};
 use crate::cpu::textures::texture::{texture_alpha, triangle_uv, Textures};
 use crate::cpu::textures::vertex_color::vertex_color;

@@ -7,7 +7,8 @@
 
 use crate::cpu::core::ray::Ray;
 use crate::cpu::geometry::alpha::hit_scene_triangle;
-use crate::cpu::geometry::intersect::{ClosestPrimitive, Geometry};
+use crate::cpu::geometry::hit::ClosestPrimitive;
+use crate::cpu::geometry::scene_geometry::Geometry;
 use crate::cpu::geometry::triangle::triangle_ray;
 use crate::kernel::types::{Instance, Triangle, TriangleNormals, NO_INSTANCE, PRIMITIVE_TRIANGLE};
 use glam::Vec3;

@@ -1,10 +1,19 @@
-//! Ray-scene intersection (WGSL side: `shaders/geometry/intersect.wgsl`). Ray directions are unit length.
+//! Ray-scene intersection (WGSL side: `shaders/geometry/intersect.wgsl`): the closest primitive,
+//! shadow rays' tests and the full hit, through whichever structure the scene has (the BVH
+//! walks of `crate::cpu::traverse`, or the scan), built on `hit.rs`'s tests. Ray directions
+//! are unit length.
 
 use crate::cpu::core::ray::Ray;
-use crate::cpu::geometry::alpha::{hit_scene_triangle, AlphaTest};
+use crate::cpu::geometry::alpha::hit_scene_triangle;
+use crate::cpu::geometry::hit::hit_quad;
+use crate::cpu::geometry::hit::hit_sphere;
+use crate::cpu::geometry::hit::ClosestPrimitive;
+use crate::cpu::geometry::hit::Hit;
+use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::geometry::instance::{
     own_triangle_count, scan_instances, scene_triangle, scene_triangle_normals,
 };
+use crate::cpu::geometry::scene_geometry::Geometry;
 use crate::cpu::geometry::shading_normal::valid_shading_normal;
 use crate::cpu::geometry::surface::{parametric_point, sphere_point};
 use crate::cpu::geometry::triangle::{
@@ -13,147 +22,9 @@ use crate::cpu::geometry::triangle::{
 use crate::cpu::textures::texture::{both_sets, sphere_uv, triangle_uv};
 use crate::cpu::traverse::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
 use crate::kernel::types::{
-    BvhNode, BvhWideNode, Instance, Quad, Sphere, Triangle, TriangleNormals, TriangleUvs,
     NO_INSTANCE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec2, Vec3, Vec4};
-
-/// The scene's surfaces as the kernel's intersection code reads them. With `bvh_nodes` empty,
-/// every ray tests every primitive (the kernel's `USE_BVH = false`).
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Geometry<'a> {
-    pub spheres: &'a [Sphere],
-    pub quads: &'a [Quad],
-    pub triangles: &'a [Triangle],
-    pub triangle_normals: &'a [TriangleNormals],
-    pub bvh_nodes: &'a [BvhNode],
-    pub bvh_primitives: &'a [u32],
-    /// Instanced meshes' placements (`instance.rs`); empty without any.
-    pub instances: &'a [Instance],
-    /// The same tree 4 wide, traversed instead of `bvh_nodes` when not empty (the CPU's
-    /// layout: src/kernel/bvh/layout.rs).
-    pub bvh_wide_nodes: &'a [BvhWideNode],
-    /// One per triangle when `textured`.
-    pub triangle_uvs: &'a [TriangleUvs],
-    /// The second set, where a texture reads it (else empty).
-    pub triangle_uvs1: &'a [TriangleUvs],
-    /// Whether hits need texture coordinates (the kernel's `HAS_TEXTURES`).
-    pub textured: bool,
-    /// Alpha-tested and blended triangles (`alpha.rs`); off by default.
-    pub alpha: AlphaTest<'a>,
-}
-
-impl<'a> Geometry<'a> {
-    /// Spheres and quads only, tested one by one.
-    pub fn new(spheres: &'a [Sphere], quads: &'a [Quad]) -> Geometry<'a> {
-        Geometry {
-            spheres,
-            quads,
-            ..Default::default()
-        }
-    }
-}
-
-pub const NO_HIT: f32 = 3.402823e38;
-
-#[derive(Clone, Copy, Debug)]
-pub struct Hit {
-    pub t: f32,
-    /// The hit point, put back on the surface (`surface.rs`), so errors cannot build up over
-    /// many bounces, and a bound on its rounding error per coordinate.
-    pub position: Vec3,
-    pub error: Vec3,
-    /// Geometric normal, unit length, facing against the incoming ray. It alone decides which
-    /// side of the surface a ray is on (offsets, entering or leaving glass).
-    pub normal: Vec3,
-    /// The normal to shade with, on the geometric normal's side: interpolated vertex normals
-    /// on smooth triangles, the geometric normal elsewhere.
-    pub shading_normal: Vec3,
-    pub material: u32,
-    /// True when the ray hit the side the surface's outward normal points to.
-    pub front_face: bool,
-    /// Which primitive: `PRIMITIVE_SPHERE`, `PRIMITIVE_QUAD` or `PRIMITIVE_TRIANGLE`, and its index.
-    pub primitive: u32,
-    pub index: u32,
-    /// Texture coordinates, set 0 in xy and set 1 in zw (`texture.rs`'s `both_sets`);
-    /// computed only when `Geometry::textured`.
-    pub uv: Vec4,
-    /// A triangle hit's barycentrics (of v0, v1, v2), for its vertex tangents
-    /// (`normal_map.rs`); zero on other primitives.
-    pub barycentrics: Vec3,
-}
-
-/// Nearest t > 0 of a sphere hit, or `NO_HIT`. The discriminant is r² − |oc − h d|² rather
-/// than h² − c, which cancels catastrophically for small spheres far from the ray origin.
-#[inline]
-pub fn hit_sphere(s: &Sphere, ray: &Ray) -> f32 {
-    let oc = Vec3::from(s.center) - ray.origin;
-    let h = ray.dir.dot(oc);
-    let perp = oc - h * ray.dir;
-    let r2 = s.radius * s.radius;
-    let disc = r2 - perp.dot(perp);
-    if disc < 0.0 {
-        return NO_HIT;
-    }
-    let c = oc.dot(oc) - r2;
-    // Roots of t² − 2ht + c = 0 in the cancellation-free form: q and c / q.
-    let q = h + if h >= 0.0 { 1.0 } else { -1.0 } * disc.sqrt();
-    let t0 = q.min(c / q);
-    let t1 = q.max(c / q);
-    if t0 > 0.0 {
-        return t0;
-    }
-    if t1 > 0.0 {
-        return t1;
-    }
-    NO_HIT
-}
-
-/// t of a quad hit, or `NO_HIT`: the plane, then 0 ≤ (u·w)/(u·u) ≤ 1 and 0 ≤ (v·w)/(v·v) ≤ 1
-/// for the offset w of the hit point from the corner.
-#[inline]
-pub fn hit_quad(q: &Quad, ray: &Ray) -> f32 {
-    let normal = Vec3::from(q.normal);
-    let denom = normal.dot(ray.dir);
-    if denom.abs() < 1e-12 {
-        return NO_HIT;
-    }
-    let t = (q.plane_offset - normal.dot(ray.origin)) / denom;
-    // Written to reject NaN as the WGSL does.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    if !(t > 0.0) {
-        return NO_HIT;
-    }
-    let w = ray.origin + t * ray.dir - Vec3::from(q.corner);
-    let a = Vec3::from(q.u_dual).dot(w);
-    let b = Vec3::from(q.v_dual).dot(w);
-    if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) {
-        return NO_HIT;
-    }
-    t
-}
-
-/// The nearest primitive a ray meets, without the hit's point, normal and material: all a
-/// shadow ray needs.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ClosestPrimitive {
-    /// `NO_HIT` when the ray meets nothing.
-    pub t: f32,
-    /// `PRIMITIVE_SPHERE`, `PRIMITIVE_QUAD` or `PRIMITIVE_TRIANGLE`, and its index.
-    pub primitive: u32,
-    pub index: u32,
-    /// The instance a triangle was hit through (`instance.rs`), or `NO_INSTANCE`: `index` is
-    /// then the triangle's in the arrays, which hold it in the instance's coordinates.
-    pub instance: u32,
-}
-
-/// The closest-hit rule, the same for every traversal on every device so that any structure
-/// finds the same hit: the smallest t, and among equal t the lowest primitive reference,
-/// `(kind << PRIMITIVE_KIND_SHIFT) | index`, that is spheres first, then quads, then
-/// triangles, each by index. Whether a hit at `t` on `reference` comes before the best so far.
-pub fn hit_comes_first(t: f32, reference: u32, best_t: f32, best_reference: u32) -> bool {
-    t < best_t || (t == best_t && reference < best_reference)
-}
 
 pub fn closest_primitive(geometry: &Geometry, ray: &Ray) -> ClosestPrimitive {
     if !geometry.bvh_nodes.is_empty() {

@@ -2,8 +2,10 @@
 //! triangles (with alpha testing), instances, and the shading normal.
 
 pub mod alpha;
+pub mod hit;
 pub mod instance;
 pub mod intersect;
+pub mod scene_geometry;
 pub mod shading_normal;
 pub mod surface;
 pub mod triangle;

@@ -7,7 +7,7 @@
 //! the triangles, never outside both.
 
 use crate::cpu::core::ray::Ray;
-use crate::cpu::geometry::intersect::NO_HIT;
+use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::geometry::surface::{parametric_point, SurfacePoint};
 use crate::kernel::types::Triangle;
 use glam::Vec3;

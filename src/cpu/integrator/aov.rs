@@ -2,7 +2,7 @@
 //! albedo and shading normal at the first non-specular vertex (mirror and glass chains are
 //! followed, as Open Image Denoise asks) and the camera distance of the first hit.
 
-use crate::cpu::geometry::intersect::Hit;
+use crate::cpu::geometry::hit::Hit;
 use crate::cpu::materials::material::is_delta;
 use crate::kernel::types::{Material, Params};
 use glam::Vec3;

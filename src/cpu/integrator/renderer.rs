@@ -1,6 +1,7 @@
 //! The CPU renderer: the kernel's entry point run over all pixels, rows in parallel (rayon).
 
-use crate::cpu::integrator::trace::{render_pixel, PixelStats, SceneRefs};
+use crate::cpu::integrator::trace::{render_pixel, PixelStats};
+use crate::cpu::scene_refs::SceneRefs;
 use crate::image::output::Image;
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;

@@ -3,8 +3,9 @@
 use crate::cpu::core::camera::camera_ray;
 use crate::cpu::core::ray::Ray;
 use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
-use crate::cpu::geometry::alpha::{alpha_segment_key, AlphaTest};
-use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene, Geometry, NO_HIT};
+use crate::cpu::geometry::alpha::alpha_segment_key;
+use crate::cpu::geometry::hit::NO_HIT;
+use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene};
 use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::integrator::accumulate::{accumulator_start, add_sample, merge_block};
 use crate::cpu::integrator::aov::{
@@ -12,146 +13,16 @@ use crate::cpu::integrator::aov::{
 };
 use crate::cpu::integrator::volume::volume_transmittance;
 use crate::cpu::lights::environment::environment_radiance;
+use crate::cpu::lights::light_sample::{nee_weight, power_heuristic};
 use crate::cpu::lights::punctual::sun_disks_radiance;
-use crate::cpu::lights::sampling::{
-    light_pdf, light_visible, nee_weight, power_heuristic, sample_light,
-};
+use crate::cpu::lights::sampling::{light_pdf, light_visible, sample_light};
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
+use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::normal_map::normal_mapped;
-use crate::cpu::textures::texture::{material_at, Textures};
+use crate::cpu::textures::texture::material_at;
 use crate::cpu::textures::vertex_color::vertex_colored;
-use crate::kernel::bvh::layout::BvhLayout;
-use crate::kernel::types::{
-    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
-    Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
-    TriangleUvs, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
-};
-use crate::kernel::variant::has_alpha;
-use crate::kernel::KernelScene;
+use crate::kernel::types::{Params, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE};
 use glam::Vec3;
-
-/// The scene as the kernel sees it.
-#[derive(Clone, Copy)]
-pub struct SceneRefs<'a> {
-    pub params: &'a Params,
-    pub spheres: &'a [Sphere],
-    pub quads: &'a [Quad],
-    pub materials: &'a [Material],
-    pub emitters: &'a [Emitter],
-    pub triangles: &'a [Triangle],
-    pub triangle_normals: &'a [TriangleNormals],
-    /// Empty: every ray tests every primitive.
-    pub bvh_nodes: &'a [BvhNode],
-    pub bvh_primitives: &'a [u32],
-    /// Empty: no instanced meshes.
-    pub instances: &'a [Instance],
-    /// The 4-wide tree where the CPU traverses it (src/kernel/bvh/layout.rs), else empty.
-    pub bvh_wide_nodes: &'a [BvhWideNode],
-    /// Texture descriptors and texels (`texture.rs`); empty without textures.
-    pub textures: &'a [Texture],
-    pub texels: &'a [[f32; 4]],
-    pub triangle_uvs: &'a [TriangleUvs],
-    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
-    /// empty.
-    pub triangle_uvs1: &'a [TriangleUvs],
-    /// One per triangle when a material has a normal map, else empty.
-    pub triangle_tangents: &'a [TriangleTangents],
-    /// One per triangle when a mesh has vertex colours, else empty.
-    pub triangle_colors: &'a [TriangleColors],
-    /// Empty without an environment map.
-    pub environment_texels: &'a [EnvironmentTexel],
-    pub environment_alias: &'a [EnvironmentAlias],
-    /// Point, spot and directional lights (`punctual.rs`).
-    pub lights: &'a [Light],
-    /// What intersection reads: the arrays above, and the key of the ray segment being traced
-    /// (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`. Built once
-    /// here, not per ray: building it for every ray and shadow ray was 3% of a CPU render.
-    pub geometry: Geometry<'a>,
-}
-
-impl<'a> SceneRefs<'a> {
-    /// `scene`'s arrays with `params` in place of its own.
-    pub fn of(scene: &'a KernelScene, params: &'a Params) -> SceneRefs<'a> {
-        let mut refs = SceneRefs {
-            params,
-            spheres: &scene.spheres,
-            quads: &scene.quads,
-            materials: &scene.materials,
-            emitters: &scene.emitters,
-            triangles: &scene.triangles,
-            triangle_normals: &scene.triangle_normals,
-            bvh_nodes: &scene.bvh_nodes,
-            bvh_primitives: &scene.bvh_primitives,
-            instances: &scene.instances,
-            bvh_wide_nodes: match BvhLayout::for_cpu() {
-                BvhLayout::Wide => &scene.bvh_wide_nodes,
-                BvhLayout::Binary => &[],
-            },
-            environment_texels: &scene.environment_texels,
-            environment_alias: &scene.environment_alias,
-            textures: &scene.textures,
-            texels: &scene.texels,
-            triangle_uvs: &scene.triangle_uvs,
-            triangle_uvs1: &scene.triangle_uvs1,
-            triangle_tangents: &scene.triangle_tangents,
-            triangle_colors: &scene.triangle_colors,
-            lights: &scene.lights,
-            geometry: Geometry::default(),
-        };
-        refs.geometry = refs.build_geometry();
-        refs
-    }
-
-    /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
-    pub fn has_alpha(&self) -> bool {
-        self.geometry.alpha.enabled
-    }
-
-    /// What texture lookups read.
-    pub fn textures(&self) -> Textures<'a> {
-        Textures {
-            descriptors: self.textures,
-            texels: self.texels,
-        }
-    }
-
-    /// The same scene tracing the ray segment whose alpha key is `key`.
-    pub fn with_alpha_key(&self, key: u32) -> SceneRefs<'a> {
-        let mut keyed = *self;
-        keyed.geometry.alpha.key = key;
-        keyed
-    }
-
-    /// What intersection reads.
-    pub fn geometry(&self) -> Geometry<'a> {
-        self.geometry
-    }
-
-    fn build_geometry(&self) -> Geometry<'a> {
-        Geometry {
-            spheres: self.spheres,
-            quads: self.quads,
-            triangles: self.triangles,
-            triangle_normals: self.triangle_normals,
-            bvh_nodes: self.bvh_nodes,
-            bvh_primitives: self.bvh_primitives,
-            instances: self.instances,
-            bvh_wide_nodes: self.bvh_wide_nodes,
-            triangle_uvs: self.triangle_uvs,
-            triangle_uvs1: self.triangle_uvs1,
-            textured: !self.textures.is_empty(),
-            alpha: AlphaTest {
-                enabled: has_alpha(self.materials),
-                materials: self.materials,
-                textures: self.textures(),
-                triangle_uvs: self.triangle_uvs,
-                triangle_uvs1: self.triangle_uvs1,
-                triangle_colors: self.triangle_colors,
-                key: 0,
-            },
-        }
-    }
-}
 
 /// A path in flight: what one more segment needs.
 #[derive(Clone, Copy, Debug)]

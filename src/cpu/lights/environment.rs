@@ -4,7 +4,7 @@
 
 use crate::cpu::core::frame::PI;
 use crate::cpu::core::rng::Rng;
-use crate::cpu::integrator::trace::SceneRefs;
+use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::texture::polynomial_atan2;
 use crate::kernel::types::Params;
 use glam::Vec3;

@@ -2,5 +2,6 @@
 //! environment map, with the MIS weights they share.
 
 pub mod environment;
+pub mod light_sample;
 pub mod punctual;
 pub mod sampling;

@@ -8,9 +8,10 @@
 use crate::cpu::core::frame::{basis, PI};
 use crate::cpu::core::ray::Ray;
 use crate::cpu::geometry::intersect::{closest_primitive, escapes};
-use crate::cpu::integrator::trace::SceneRefs;
-use crate::cpu::lights::sampling::{power_heuristic, LightSample};
-use crate::cpu::traverse::bvh::{bvh_ray, bvh_traverse};
+use crate::cpu::lights::light_sample::{power_heuristic, LightSample};
+use crate::cpu::scene_refs::SceneRefs;
+use crate::cpu::traverse::bvh::bvh_traverse;
+use crate::cpu::traverse::bvh_ray::bvh_ray;
 use crate::kernel::types::{
     Light, LIGHT_SUN, PRIMITIVE_ENVIRONMENT, PRIMITIVE_KIND_SHIFT, PRIMITIVE_LIGHT,
 };
@@ -97,7 +98,7 @@ pub fn punctual_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) ->
         // Any hit nearer than the light ends the search (a target no primitive matches).
         let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
         return bvh_traverse(geometry, &bvh_ray(shadow), t_light, t_light, 0, no_target).t
-            == crate::cpu::geometry::intersect::NO_HIT;
+            == crate::cpu::geometry::hit::NO_HIT;
     }
     closest_primitive(geometry, shadow).t >= t_light
 }

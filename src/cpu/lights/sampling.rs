@@ -12,27 +12,16 @@ use crate::cpu::geometry::intersect::first_hit_is;
 use crate::cpu::geometry::triangle::{
     triangle_normal, triangle_plane_distance, triangle_point, triangle_sample_barycentrics,
 };
-use crate::cpu::integrator::trace::SceneRefs;
 use crate::cpu::lights::environment::{environment_pdf, sample_environment};
+use crate::cpu::lights::light_sample::LightSample;
 use crate::cpu::lights::punctual::{punctual_visible, sample_punctual};
+use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::texture::{emission_at, triangle_uv};
 use crate::cpu::textures::vertex_color::vertex_colored_emission;
 use crate::kernel::types::{
     Sphere, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
-
-#[derive(Clone, Copy, Debug)]
-pub struct LightSample {
-    pub dir: Vec3,
-    /// Solid-angle pdf of `dir`; 0 when no light could be sampled.
-    pub pdf: f32,
-    pub radiance: Vec3,
-    pub primitive: u32,
-    pub index: u32,
-    /// A point, spot or delta sun: no BSDF-sampled ray reaches it, so its MIS weight is 1.
-    pub is_delta: bool,
-}
 
 /// The emitter light sampling chose: which primitive, and the probability of choosing it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -245,38 +234,4 @@ pub fn light_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) -> bo
         return punctual_visible(scene, shadow, light);
     }
     first_hit_is(&scene.geometry, shadow, light.primitive, light.index)
-}
-
-/// The MIS weight of a light sample against BSDF sampling, which would have drawn its
-/// direction with `bsdf_pdf`: 1 for delta lights, which BSDF sampling cannot reach.
-pub fn nee_weight(light: &LightSample, bsdf_pdf: f32) -> f32 {
-    if light.is_delta {
-        return 1.0;
-    }
-    power_heuristic(light.pdf, bsdf_pdf)
-}
-
-/// Veach's power heuristic (β = 2) for the sample drawn with pdf `a` against pdf `b`:
-/// a² / (a² + b²), written with the ratio of the smaller pdf to the larger so that nothing
-/// overflows (a light pdf can exceed 10¹⁹, whose square is infinite in f32). Infinite pdfs (a
-/// light too small or too grazing to sample) are taken as the largest finite ones.
-pub fn power_heuristic(a: f32, b: f32) -> f32 {
-    // Written to reject NaN as the WGSL does.
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    if !(a > 0.0) {
-        return 0.0;
-    }
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    if !(b > 0.0) {
-        return 1.0;
-    }
-    let a_max = a.min(f32::MAX);
-    let b_max = b.min(f32::MAX);
-    if a_max >= b_max {
-        let r = b_max / a_max;
-        return 1.0 / (1.0 + r * r);
-    }
-    let r = a_max / b_max;
-    let r2 = r * r;
-    r2 / (1.0 + r2)
 }

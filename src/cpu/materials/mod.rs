@@ -13,5 +13,6 @@ pub mod material;
 pub mod microfacet;
 pub mod pbr;
 pub mod rough_dielectric;
+pub mod rough_dielectric_single;
 pub mod sheen;
 pub mod sheen_energy;

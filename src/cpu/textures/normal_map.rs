@@ -4,7 +4,7 @@
 //! still decides sides, and the result is kept on the geometric normal's side and made valid
 //! for the outgoing direction as interpolated normals are (`shading_normal.rs`).
 
-use crate::cpu::geometry::intersect::Hit;
+use crate::cpu::geometry::hit::Hit;
 use crate::cpu::geometry::shading_normal::valid_shading_normal;
 use crate::cpu::textures::texture::{texture_lookup, Textures};
 use crate::kernel::types::TriangleTangents;

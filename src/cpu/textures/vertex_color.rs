@@ -4,7 +4,7 @@
 //! (KHR_materials_unlit), so there the colour multiplies the emission, at hits and at light
 //! samples alike.
 
-use crate::cpu::geometry::intersect::Hit;
+use crate::cpu::geometry::hit::Hit;
 use crate::kernel::types::{Material, TriangleColors, MATERIAL_UNLIT, PRIMITIVE_TRIANGLE};
 use glam::{Vec3, Vec4};
 

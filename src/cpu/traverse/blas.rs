@@ -6,9 +6,11 @@
 
 use crate::cpu::core::ray::Ray;
 use crate::cpu::geometry::alpha::hit_scene_triangle;
+use crate::cpu::geometry::hit::{hit_comes_first, NO_HIT};
 use crate::cpu::geometry::instance::object_ray;
-use crate::cpu::geometry::intersect::{hit_comes_first, Geometry, NO_HIT};
-use crate::cpu::traverse::bvh::{bvh_ray, hit_box, widened, BVH_STACK_SIZE};
+use crate::cpu::geometry::scene_geometry::Geometry;
+use crate::cpu::traverse::bvh_ray::{bvh_ray, hit_box, widened};
+use crate::kernel::bvh::BVH_STACK_SIZE;
 use crate::kernel::types::PRIMITIVE_INDEX_MASK;
 
 /// An instance's closest triangle: its t (`NO_HIT` for none), its index in the triangle

@@ -4,4 +4,5 @@
 
 pub mod blas;
 pub mod bvh;
+pub mod bvh_ray;
 pub mod wide;

@@ -5,8 +5,10 @@
 //! A node's four boxes are tested at once, and its children are pushed farthest first, so
 //! the nearest is visited next; entries popped beyond the best hit so far are skipped.
 
-use crate::cpu::geometry::intersect::{hit_comes_first, ClosestPrimitive, Geometry, NO_HIT};
-use crate::cpu::traverse::bvh::{hit_primitive, widened, BvhRay, BOX_SLACK, NO_PRIMITIVE};
+use crate::cpu::geometry::hit::{hit_comes_first, ClosestPrimitive, NO_HIT};
+
+use crate::cpu::geometry::scene_geometry::Geometry;
+use crate::cpu::traverse::bvh_ray::{hit_primitive, widened, BvhRay, BOX_SLACK, NO_PRIMITIVE};
 use crate::kernel::bvh::wide::WIDE_STACK_SIZE;
 use crate::kernel::types::{
     BvhWideNode, NO_INSTANCE, PRIMITIVE_INDEX_MASK, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD,

@@ -3,26 +3,20 @@
 //! table). Everything is checked here, before rendering: unreadable or malformed files, vertices
 //! that are not finite, indices out of range, meshes left with no triangles.
 //!
-//! One file per format (`obj.rs`, `ply.rs`, `gltf.rs`; a glTF file's node hierarchy, cameras
-//! and punctual lights in `gltf_nodes.rs`, `gltf_cameras.rs`, `gltf_lights.rs`;
-//! `EXT_mesh_gpu_instancing` in `gltf_instancing.rs`); which parts are stored once rather
+//! One file per format (`obj.rs`, `ply.rs`, and glTF's folder `gltf/`, whose `mod.rs` lists its
+//! files); which parts are stored once rather
 //! than copied in `reuse.rs`; this file holds what they share: the parts a file yields, the
 //! material checks, and turning parts into scene triangles and instanced meshes.
 
 mod gltf;
-mod gltf_cameras;
-mod gltf_instancing;
-mod gltf_lights;
-mod gltf_material;
-mod gltf_nodes;
 mod obj;
 mod ply;
 mod reuse;
 mod tangents;
 
+pub use self::gltf::cameras::{gltf_camera, no_such_camera, FileCamera};
+pub use self::gltf::lights::{gltf_lights, unit, LUMENS_PER_WATT};
 pub use self::gltf::{ExtensionSupport, GLTF_EXTENSIONS};
-pub use gltf_cameras::{gltf_camera, no_such_camera, FileCamera};
-pub use gltf_lights::{gltf_lights, unit, LUMENS_PER_WATT};
 
 use super::limits::{MAX_IOR, MAX_NORMAL_SCALE, MAX_RADIANCE, MIN_IOR};
 use super::texture::{Sampling, TextureSet, TextureUse};

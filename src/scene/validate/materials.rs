@@ -49,34 +49,58 @@ pub(super) fn validate_materials(
     let mut textures = TextureSet::default();
     let mut index_of = BTreeMap::new();
     for (name, m) in toml {
-        let m = m.get_ref();
-        let field = |f: &str| format!("materials.{name}.{f}");
-        let positive = |x: &Option<S<Real>>, name: &str, what: &str| -> Result<f32, FieldError> {
-            let Some(x) = x else {
+        index_of.insert(name.clone(), materials.len() as u32);
+        materials.push(validate_material(name, m.get_ref(), folder, &mut textures)?);
+    }
+    Ok(Materials {
+        list: materials,
+        textures,
+        index_of,
+    })
+}
+
+/// `[materials.NAME]`, its textures added to `textures`. The checks run in the order the
+/// fields' errors are reported: the kind and its parameters, fields that do not apply to it,
+/// the colour, the emission, alpha and the normal map.
+fn validate_material(
+    name: &str,
+    m: &MaterialToml,
+    folder: &Path,
+    textures: &mut TextureSet,
+) -> Result<Material, FieldError> {
+    let field = &|f: &str| format!("materials.{name}.{f}");
+    let kind = match m.kind.get_ref().as_str() {
+        "diffuse" => MaterialKind::Diffuse,
+        "specular" => MaterialKind::Specular,
+        "metal" => {
+            let Some(r) = &m.roughness else {
                 return fail(
                     m.kind.span(),
-                    field(name),
-                    format!("missing: a {what} needs {name}"),
+                    field("roughness"),
+                    "missing: a metal needs roughness",
                 );
             };
-            real(x, &field(name))
-        };
-        // A number in [0, 1], or `default` when absent.
-        let unit = |x: &Option<S<Real>>, name: &str, default: f32| -> Result<f32, FieldError> {
-            let Some(x) = x else {
-                return Ok(default);
+            let roughness = match r.get_ref() {
+                RoughnessToml::Value(v) => {
+                    real(&S::new(r.span(), *v), &field("roughness"))?
+                }
+                // A texture (read below); the constant is unused.
+                RoughnessToml::Other(_) => 1.0,
             };
-            let v = real(x, &field(name))?;
-            if !(0.0..=1.0).contains(&v) {
-                return fail(x.span(), field(name), format!("must be in [0, 1], got {v}"));
+            if !(0.0..=1.0).contains(&roughness) {
+                return fail(
+                    r.span(),
+                    field("roughness"),
+                    format!("must be in [0, 1] (0 = mirror), got {roughness}"),
+                );
             }
-            Ok(v)
-        };
-        let ior_in_range = |x: &S<Real>| -> Result<f32, FieldError> {
-            let ior = real(x, &field("ior"))?;
+            MaterialKind::Metal { roughness }
+        }
+        "dielectric" => {
+            let ior = positive(m, &m.ior, "ior", "dielectric", field)?;
             if !(MIN_IOR..=MAX_IOR).contains(&ior) {
                 return fail(
-                    x.span(),
+                    m.ior.as_ref().unwrap().span(),
                     field("ior"),
                     format!(
                         "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
@@ -84,380 +108,405 @@ pub(super) fn validate_materials(
                     ),
                 );
             }
-            Ok(ior)
-        };
-        let kind = match m.kind.get_ref().as_str() {
-            "diffuse" => MaterialKind::Diffuse,
-            "specular" => MaterialKind::Specular,
-            "metal" => {
-                let Some(r) = &m.roughness else {
-                    return fail(
-                        m.kind.span(),
-                        field("roughness"),
-                        "missing: a metal needs roughness",
-                    );
-                };
-                let roughness = match r.get_ref() {
-                    RoughnessToml::Value(v) => {
-                        real(&S::new(r.span(), *v), &field("roughness"))?
-                    }
-                    // A texture (read below); the constant is unused.
-                    RoughnessToml::Other(_) => 1.0,
-                };
-                if !(0.0..=1.0).contains(&roughness) {
-                    return fail(
-                        r.span(),
-                        field("roughness"),
-                        format!("must be in [0, 1] (0 = mirror), got {roughness}"),
-                    );
-                }
-                MaterialKind::Metal { roughness }
-            }
-            "dielectric" => {
-                let ior = positive(&m.ior, "ior", "dielectric")?;
-                if !(MIN_IOR..=MAX_IOR).contains(&ior) {
-                    return fail(
-                        m.ior.as_ref().unwrap().span(),
-                        field("ior"),
-                        format!(
-                            "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
-                             numeric range glint supports), got {ior}"
-                        ),
-                    );
-                }
-                MaterialKind::Dielectric { ior }
-            }
-            "pbr" => {
-                let roughness = match m.roughness.as_ref().map(|r| (r.span(), r.get_ref())) {
-                    Some((span, RoughnessToml::Value(v))) => {
-                        let v = real(&S::new(span.clone(), *v), &field("roughness"))?;
-                        if !(0.0..=1.0).contains(&v) {
-                            return fail(
-                                span,
-                                field("roughness"),
-                                format!("must be in [0, 1], got {v}"),
-                            );
-                        }
-                        v
-                    }
-                    // A texture (read below); the constant is unused.
-                    Some((_, RoughnessToml::Other(_))) => 1.0,
-                    None => 0.5,
-                };
-                let specular_color = match &m.specular_color {
-                    Some(c) => non_negative(c, &field("specular_color"))?,
-                    None => Vec3::ONE,
-                };
-                let attenuation_color = match &m.attenuation_color {
-                    Some(c) => {
-                        let color = non_negative(c, &field("attenuation_color"))?;
-                        if color.max_element() > 1.0 {
-                            return fail(
-                                c.span(),
-                                field("attenuation_color"),
-                                format!("must be in [0, 1] (a fraction of the light that remains), got {color}"),
-                            );
-                        }
-                        color
-                    }
-                    None => Vec3::ONE,
-                };
-                let attenuation_distance = match &m.attenuation_distance {
-                    Some(d) => {
-                        let v = real(d, &field("attenuation_distance"))?;
-                        if v <= 0.0 {
-                            return fail(
-                                d.span(),
-                                field("attenuation_distance"),
-                                format!("must be > 0 (leave it out for no attenuation), got {v}"),
-                            );
-                        }
-                        Some(v)
-                    }
-                    None => None,
-                };
-                // A constant in [0, 1], or a texture whose first channel is the value.
-                let mut scalar = |x: &Option<S<RoughnessToml>>,
-                                  name: &str,
-                                  default: f32|
-                 -> Result<(f32, Option<u32>), FieldError> {
-                    match x.as_ref().map(|r| (r.span(), r.get_ref())) {
-                        Some((span, RoughnessToml::Value(v))) => {
-                            let v = real(&S::new(span.clone(), *v), &field(name))?;
-                            if !(0.0..=1.0).contains(&v) {
-                                return fail(span, field(name), format!("must be in [0, 1], got {v}"));
-                            }
-                            Ok((v, None))
-                        }
-                        Some((span, RoughnessToml::Other(value))) => Ok((
-                            1.0,
-                            Some(texture(
-                                &S::new(span, value.clone()),
-                                &field(name),
-                                folder,
-                                TextureUse::Roughness,
-                                &mut textures,
-                            )?),
-                        )),
-                        None => Ok((default, None)),
-                    }
-                };
-                let (clearcoat, clearcoat_texture) = scalar(&m.clearcoat, "clearcoat", 0.0)?;
-                let (clearcoat_roughness, clearcoat_roughness_texture) =
-                    scalar(&m.clearcoat_roughness, "clearcoat_roughness", 0.0)?;
-                let (sheen_roughness, sheen_roughness_texture) =
-                    scalar(&m.sheen_roughness, "sheen_roughness", 0.0)?;
-                let (sheen_color, sheen_color_texture) = match &m.sheen_color {
-                    Some(c) if c.get_ref().is_table() => (
-                        Vec3::ONE,
-                        Some(texture(
-                            c,
-                            &field("sheen_color"),
-                            folder,
-                            TextureUse::Color,
-                            &mut textures,
-                        )?),
-                    ),
-                    Some(c) => {
-                        let color = non_negative(c, &field("sheen_color"))?;
-                        if color.max_element() > 1.0 {
-                            return fail(
-                                c.span(),
-                                field("sheen_color"),
-                                format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
-                            );
-                        }
-                        (color, None)
-                    }
-                    None => (Vec3::ZERO, None),
-                };
-                // A coat's normal map without a coat would map nothing: most likely a mistake.
-                if let Some(n) = &m.clearcoat_normal_map {
-                    if clearcoat == 0.0 && clearcoat_texture.is_none() {
-                        return fail(
-                            n.span(),
-                            field("clearcoat_normal_map"),
-                            "the material has no coat to map: give it clearcoat > 0",
-                        );
-                    }
-                }
-                let clearcoat_normal_texture = m
-                    .clearcoat_normal_map
-                    .as_ref()
-                    .map(|n| normal_map(n, &field("clearcoat_normal_map"), folder, &mut textures))
-                    .transpose()?;
-                let layers = PbrLayers {
-                    clearcoat,
-                    clearcoat_roughness,
-                    clearcoat_texture,
-                    clearcoat_roughness_texture,
-                    clearcoat_normal_texture,
-                    sheen_color,
-                    sheen_roughness,
-                    sheen_color_texture,
-                    sheen_roughness_texture,
-                };
-                MaterialKind::Pbr {
-                    roughness,
-                    metallic: unit(&m.metallic, "metallic", 0.0)?,
-                    ior: m.ior.as_ref().map_or(Ok(1.5), ior_in_range)?,
-                    specular: unit(&m.specular, "specular", 1.0)?,
-                    specular_color,
-                    transmission: unit(&m.transmission, "transmission", 0.0)?,
-                    transmission_texture: None,
-                    attenuation_color,
-                    attenuation_distance,
-                    layers,
-                }
-            }
-            other => {
-                return fail(
-                    m.kind.span(),
-                    field("type"),
-                    format!(
-                        "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\", \"pbr\""
-                    ),
-                )
-            }
-        };
-        let pbr = matches!(kind, MaterialKind::Pbr { .. });
-        // A field that does not apply is most likely a mistake: say so.
-        for (span, name, applies) in [
-            (
-                m.roughness.as_ref().map(|r| r.span()),
-                "roughness",
-                matches!(kind, MaterialKind::Metal { .. } | MaterialKind::Pbr { .. }),
-            ),
-            (
-                m.ior.as_ref().map(|r| r.span()),
-                "ior",
-                matches!(
-                    kind,
-                    MaterialKind::Dielectric { .. } | MaterialKind::Pbr { .. }
+            MaterialKind::Dielectric { ior }
+        }
+        "pbr" => pbr_kind(m, field, folder, textures)?,
+        other => {
+            return fail(
+                m.kind.span(),
+                field("type"),
+                format!(
+                    "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\", \"pbr\""
                 ),
-            ),
-            (
-                m.color.as_ref().map(|r| r.span()),
-                "color",
-                !matches!(kind, MaterialKind::Pbr { .. }),
-            ),
-            (m.base_color.as_ref().map(|r| r.span()), "base_color", pbr),
-            (m.metallic.as_ref().map(|r| r.span()), "metallic", pbr),
-            (m.specular.as_ref().map(|r| r.span()), "specular", pbr),
-            (
-                m.specular_color.as_ref().map(|r| r.span()),
-                "specular_color",
-                pbr,
-            ),
-            (
-                m.transmission.as_ref().map(|r| r.span()),
-                "transmission",
-                pbr,
-            ),
-            (
-                m.attenuation_color.as_ref().map(|r| r.span()),
-                "attenuation_color",
-                pbr,
-            ),
-            (
-                m.attenuation_distance.as_ref().map(|r| r.span()),
-                "attenuation_distance",
-                pbr,
-            ),
-            (m.clearcoat.as_ref().map(|r| r.span()), "clearcoat", pbr),
-            (
-                m.clearcoat_roughness.as_ref().map(|r| r.span()),
-                "clearcoat_roughness",
-                pbr,
-            ),
-            (
-                m.clearcoat_normal_map.as_ref().map(|r| r.span()),
-                "clearcoat_normal_map",
-                pbr,
-            ),
-            (m.sheen_color.as_ref().map(|r| r.span()), "sheen_color", pbr),
-            (
-                m.sheen_roughness.as_ref().map(|r| r.span()),
-                "sheen_roughness",
-                pbr,
-            ),
-        ] {
-            if let (Some(span), false) = (span, applies) {
+            )
+        }
+    };
+    let pbr = matches!(kind, MaterialKind::Pbr { .. });
+    check_fields_apply(m, &kind, field)?;
+    let roughness_texture = match &m.roughness {
+        Some(r) => match r.get_ref() {
+            RoughnessToml::Other(value) => Some(texture(
+                &S::new(r.span(), value.clone()),
+                &field("roughness"),
+                folder,
+                TextureUse::Roughness,
+                textures,
+            )?),
+            RoughnessToml::Value(_) => None,
+        },
+        None => None,
+    };
+    // A pbr material's colour is its base_color.
+    let (color_field, color_name) = if pbr {
+        (&m.base_color, "base_color")
+    } else {
+        (&m.color, "color")
+    };
+    let color_texture = match color_field {
+        Some(c) if c.get_ref().is_table() => Some(texture(
+            c,
+            &field(color_name),
+            folder,
+            TextureUse::Color,
+            textures,
+        )?),
+        _ => None,
+    };
+    let color = match (color_field, kind) {
+        // Textured: the constant is unused.
+        (Some(_), _) if color_texture.is_some() => Vec3::ONE,
+        (Some(c), _) => {
+            let color = non_negative(c, &field(color_name))?;
+            if color.max_element() > 1.0 {
+                return fail(
+                    c.span(),
+                    field(color_name),
+                    format!(
+                        "a reflectance must be in [0, 1] (more would create energy), got {color}"
+                    ),
+                );
+            }
+            color
+        }
+        // Clear glass unless tinted.
+        (None, MaterialKind::Dielectric { .. }) => Vec3::ONE,
+        (None, _) => {
+            return fail(
+                m.kind.span(),
+                field(color_name),
+                format!("missing: this material needs a {color_name}"),
+            );
+        }
+    };
+    let emission = match &m.emission {
+        Some(e) if e.get_ref().is_table() => {
+            return fail(
+                e.span(),
+                field("emission"),
+                "takes no texture: only color (and a metal's roughness) may be textured",
+            )
+        }
+        Some(e) => non_negative(e, &field("emission"))?,
+        None => Vec3::ZERO,
+    };
+    let strength = match &m.strength {
+        Some(s) => {
+            let v = real(s, &field("strength"))?;
+            if v < 0.0 {
+                return fail(s.span(), field("strength"), format!("must be ≥ 0, got {v}"));
+            }
+            v
+        }
+        None => 1.0,
+    };
+    // Each factor may be in range and the product not (1e30 × 1e30): check the product,
+    // in f64, where it is exact enough and cannot overflow.
+    if let Some(e) = &m.emission {
+        let span = m.strength.as_ref().map_or(e.span(), |s| s.span());
+        radiance_in_range(
+            span,
+            &field("emission × strength"),
+            emission.as_dvec3() * strength as f64,
+        )?;
+    }
+    let alpha = alpha(m, field)?;
+    let normal_texture = m
+        .normal_map
+        .as_ref()
+        .map(|n| normal_map(n, &field("normal_map"), folder, textures))
+        .transpose()?;
+    Ok(Material {
+        name: name.to_string(),
+        kind,
+        color,
+        emitted_radiance: emission * strength,
+        color_texture,
+        roughness_texture,
+        emission_texture: None,
+        normal_texture,
+        alpha,
+    })
+}
+
+/// A value that must be given for this kind of material.
+fn positive(
+    m: &MaterialToml,
+    x: &Option<S<Real>>,
+    name: &str,
+    what: &str,
+    field: &dyn Fn(&str) -> String,
+) -> Result<f32, FieldError> {
+    let Some(x) = x else {
+        return fail(
+            m.kind.span(),
+            field(name),
+            format!("missing: a {what} needs {name}"),
+        );
+    };
+    real(x, &field(name))
+}
+
+/// A number in [0, 1], or `default` when absent.
+fn unit(
+    x: &Option<S<Real>>,
+    name: &str,
+    default: f32,
+    field: &dyn Fn(&str) -> String,
+) -> Result<f32, FieldError> {
+    let Some(x) = x else {
+        return Ok(default);
+    };
+    let v = real(x, &field(name))?;
+    if !(0.0..=1.0).contains(&v) {
+        return fail(x.span(), field(name), format!("must be in [0, 1], got {v}"));
+    }
+    Ok(v)
+}
+
+/// A `pbr` material's parameters and layers, its textures added to `textures`.
+fn pbr_kind(
+    m: &MaterialToml,
+    field: &dyn Fn(&str) -> String,
+    folder: &Path,
+    textures: &mut TextureSet,
+) -> Result<MaterialKind, FieldError> {
+    let ior_in_range = |x: &S<Real>| -> Result<f32, FieldError> {
+        let ior = real(x, &field("ior"))?;
+        if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+            return fail(
+                x.span(),
+                field("ior"),
+                format!(
+                    "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
+                     numeric range glint supports), got {ior}"
+                ),
+            );
+        }
+        Ok(ior)
+    };
+    let roughness = match m.roughness.as_ref().map(|r| (r.span(), r.get_ref())) {
+        Some((span, RoughnessToml::Value(v))) => {
+            let v = real(&S::new(span.clone(), *v), &field("roughness"))?;
+            if !(0.0..=1.0).contains(&v) {
                 return fail(
                     span,
-                    field(name),
-                    format!("{name} does not apply to a {} material", m.kind.get_ref()),
+                    field("roughness"),
+                    format!("must be in [0, 1], got {v}"),
                 );
             }
+            v
         }
-        let roughness_texture = match &m.roughness {
-            Some(r) => match r.get_ref() {
-                RoughnessToml::Other(value) => Some(texture(
-                    &S::new(r.span(), value.clone()),
-                    &field("roughness"),
+        // A texture (read below); the constant is unused.
+        Some((_, RoughnessToml::Other(_))) => 1.0,
+        None => 0.5,
+    };
+    let specular_color = match &m.specular_color {
+        Some(c) => non_negative(c, &field("specular_color"))?,
+        None => Vec3::ONE,
+    };
+    let attenuation_color = match &m.attenuation_color {
+        Some(c) => {
+            let color = non_negative(c, &field("attenuation_color"))?;
+            if color.max_element() > 1.0 {
+                return fail(
+                    c.span(),
+                    field("attenuation_color"),
+                    format!(
+                        "must be in [0, 1] (a fraction of the light that remains), got {color}"
+                    ),
+                );
+            }
+            color
+        }
+        None => Vec3::ONE,
+    };
+    let attenuation_distance = match &m.attenuation_distance {
+        Some(d) => {
+            let v = real(d, &field("attenuation_distance"))?;
+            if v <= 0.0 {
+                return fail(
+                    d.span(),
+                    field("attenuation_distance"),
+                    format!("must be > 0 (leave it out for no attenuation), got {v}"),
+                );
+            }
+            Some(v)
+        }
+        None => None,
+    };
+    // A constant in [0, 1], or a texture whose first channel is the value.
+    let mut scalar = |x: &Option<S<RoughnessToml>>,
+                      name: &str,
+                      default: f32|
+     -> Result<(f32, Option<u32>), FieldError> {
+        match x.as_ref().map(|r| (r.span(), r.get_ref())) {
+            Some((span, RoughnessToml::Value(v))) => {
+                let v = real(&S::new(span.clone(), *v), &field(name))?;
+                if !(0.0..=1.0).contains(&v) {
+                    return fail(span, field(name), format!("must be in [0, 1], got {v}"));
+                }
+                Ok((v, None))
+            }
+            Some((span, RoughnessToml::Other(value))) => Ok((
+                1.0,
+                Some(texture(
+                    &S::new(span, value.clone()),
+                    &field(name),
                     folder,
                     TextureUse::Roughness,
-                    &mut textures,
+                    textures,
                 )?),
-                RoughnessToml::Value(_) => None,
-            },
-            None => None,
-        };
-        // A pbr material's colour is its base_color.
-        let (color_field, color_name) = if pbr {
-            (&m.base_color, "base_color")
-        } else {
-            (&m.color, "color")
-        };
-        let color_texture = match color_field {
-            Some(c) if c.get_ref().is_table() => Some(texture(
+            )),
+            None => Ok((default, None)),
+        }
+    };
+    let (clearcoat, clearcoat_texture) = scalar(&m.clearcoat, "clearcoat", 0.0)?;
+    let (clearcoat_roughness, clearcoat_roughness_texture) =
+        scalar(&m.clearcoat_roughness, "clearcoat_roughness", 0.0)?;
+    let (sheen_roughness, sheen_roughness_texture) =
+        scalar(&m.sheen_roughness, "sheen_roughness", 0.0)?;
+    let (sheen_color, sheen_color_texture) = match &m.sheen_color {
+        Some(c) if c.get_ref().is_table() => (
+            Vec3::ONE,
+            Some(texture(
                 c,
-                &field(color_name),
+                &field("sheen_color"),
                 folder,
                 TextureUse::Color,
-                &mut textures,
+                textures,
             )?),
-            _ => None,
-        };
-        let color = match (color_field, kind) {
-            // Textured: the constant is unused.
-            (Some(_), _) if color_texture.is_some() => Vec3::ONE,
-            (Some(c), _) => {
-                let color = non_negative(c, &field(color_name))?;
-                if color.max_element() > 1.0 {
-                    return fail(
-                        c.span(),
-                        field(color_name),
-                        format!("a reflectance must be in [0, 1] (more would create energy), got {color}"),
-                    );
-                }
-                color
-            }
-            // Clear glass unless tinted.
-            (None, MaterialKind::Dielectric { .. }) => Vec3::ONE,
-            (None, _) => {
+        ),
+        Some(c) => {
+            let color = non_negative(c, &field("sheen_color"))?;
+            if color.max_element() > 1.0 {
                 return fail(
-                    m.kind.span(),
-                    field(color_name),
-                    format!("missing: this material needs a {color_name}"),
+                    c.span(),
+                    field("sheen_color"),
+                    format!(
+                        "a reflectance must be in [0, 1] (more would create energy), got {color}"
+                    ),
                 );
             }
-        };
-        let emission = match &m.emission {
-            Some(e) if e.get_ref().is_table() => {
-                return fail(
-                    e.span(),
-                    field("emission"),
-                    "takes no texture: only color (and a metal's roughness) may be textured",
-                )
-            }
-            Some(e) => non_negative(e, &field("emission"))?,
-            None => Vec3::ZERO,
-        };
-        let strength = match &m.strength {
-            Some(s) => {
-                let v = real(s, &field("strength"))?;
-                if v < 0.0 {
-                    return fail(s.span(), field("strength"), format!("must be ≥ 0, got {v}"));
-                }
-                v
-            }
-            None => 1.0,
-        };
-        // Each factor may be in range and the product not (1e30 × 1e30): check the product,
-        // in f64, where it is exact enough and cannot overflow.
-        if let Some(e) = &m.emission {
-            let span = m.strength.as_ref().map_or(e.span(), |s| s.span());
-            radiance_in_range(
-                span,
-                &field("emission × strength"),
-                emission.as_dvec3() * strength as f64,
-            )?;
+            (color, None)
         }
-        let alpha = alpha(m, &field)?;
-        let normal_texture = m
-            .normal_map
-            .as_ref()
-            .map(|n| normal_map(n, &field("normal_map"), folder, &mut textures))
-            .transpose()?;
-        index_of.insert(name.clone(), materials.len() as u32);
-        materials.push(Material {
-            name: name.clone(),
-            kind,
-            color,
-            emitted_radiance: emission * strength,
-            color_texture,
-            roughness_texture,
-            emission_texture: None,
-            normal_texture,
-            alpha,
-        });
+        None => (Vec3::ZERO, None),
+    };
+    // A coat's normal map without a coat would map nothing: most likely a mistake.
+    if let Some(n) = &m.clearcoat_normal_map {
+        if clearcoat == 0.0 && clearcoat_texture.is_none() {
+            return fail(
+                n.span(),
+                field("clearcoat_normal_map"),
+                "the material has no coat to map: give it clearcoat > 0",
+            );
+        }
     }
-    Ok(Materials {
-        list: materials,
-        textures,
-        index_of,
+    let clearcoat_normal_texture = m
+        .clearcoat_normal_map
+        .as_ref()
+        .map(|n| normal_map(n, &field("clearcoat_normal_map"), folder, textures))
+        .transpose()?;
+    let layers = PbrLayers {
+        clearcoat,
+        clearcoat_roughness,
+        clearcoat_texture,
+        clearcoat_roughness_texture,
+        clearcoat_normal_texture,
+        sheen_color,
+        sheen_roughness,
+        sheen_color_texture,
+        sheen_roughness_texture,
+    };
+    Ok(MaterialKind::Pbr {
+        roughness,
+        metallic: unit(&m.metallic, "metallic", 0.0, field)?,
+        ior: m.ior.as_ref().map_or(Ok(1.5), ior_in_range)?,
+        specular: unit(&m.specular, "specular", 1.0, field)?,
+        specular_color,
+        transmission: unit(&m.transmission, "transmission", 0.0, field)?,
+        transmission_texture: None,
+        attenuation_color,
+        attenuation_distance,
+        layers,
     })
+}
+
+/// A field that does not apply to the material's kind is most likely a mistake: say so.
+fn check_fields_apply(
+    m: &MaterialToml,
+    kind: &MaterialKind,
+    field: &dyn Fn(&str) -> String,
+) -> Result<(), FieldError> {
+    let pbr = matches!(kind, MaterialKind::Pbr { .. });
+    for (span, name, applies) in [
+        (
+            m.roughness.as_ref().map(|r| r.span()),
+            "roughness",
+            matches!(kind, MaterialKind::Metal { .. } | MaterialKind::Pbr { .. }),
+        ),
+        (
+            m.ior.as_ref().map(|r| r.span()),
+            "ior",
+            matches!(
+                kind,
+                MaterialKind::Dielectric { .. } | MaterialKind::Pbr { .. }
+            ),
+        ),
+        (
+            m.color.as_ref().map(|r| r.span()),
+            "color",
+            !matches!(kind, MaterialKind::Pbr { .. }),
+        ),
+        (m.base_color.as_ref().map(|r| r.span()), "base_color", pbr),
+        (m.metallic.as_ref().map(|r| r.span()), "metallic", pbr),
+        (m.specular.as_ref().map(|r| r.span()), "specular", pbr),
+        (
+            m.specular_color.as_ref().map(|r| r.span()),
+            "specular_color",
+            pbr,
+        ),
+        (
+            m.transmission.as_ref().map(|r| r.span()),
+            "transmission",
+            pbr,
+        ),
+        (
+            m.attenuation_color.as_ref().map(|r| r.span()),
+            "attenuation_color",
+            pbr,
+        ),
+        (
+            m.attenuation_distance.as_ref().map(|r| r.span()),
+            "attenuation_distance",
+            pbr,
+        ),
+        (m.clearcoat.as_ref().map(|r| r.span()), "clearcoat", pbr),
+        (
+            m.clearcoat_roughness.as_ref().map(|r| r.span()),
+            "clearcoat_roughness",
+            pbr,
+        ),
+        (
+            m.clearcoat_normal_map.as_ref().map(|r| r.span()),
+            "clearcoat_normal_map",
+            pbr,
+        ),
+        (m.sheen_color.as_ref().map(|r| r.span()), "sheen_color", pbr),
+        (
+            m.sheen_roughness.as_ref().map(|r| r.span()),
+            "sheen_roughness",
+            pbr,
+        ),
+    ] {
+        if let (Some(span), false) = (span, applies) {
+            return fail(
+                span,
+                field(name),
+                format!("{name} does not apply to a {} material", m.kind.get_ref()),
+            );
+        }
+    }
+    Ok(())
 }
 
 /// `alpha_mode` (`"opaque"` unless given), `alpha` (default 1) and `alpha_cutoff` (default

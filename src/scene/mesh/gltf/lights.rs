@@ -12,8 +12,8 @@
 //! file's divided by 683, for every kind. A light's `range` is ignored: glint's lights fall
 //! off with the inverse square of the distance, as the extension recommends.
 
-use super::gltf::{exists, read_document};
-use super::gltf_nodes::placed_nodes;
+use super::document::{exists, read_document};
+use super::nodes::placed_nodes;
 use crate::scene::light::{Light, LightKind};
 use crate::scene::limits::{MAX_COORDINATE, MAX_RADIANCE};
 use glam::{DVec3, Mat4, Vec3};

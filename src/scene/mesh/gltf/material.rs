@@ -1,10 +1,10 @@
 //! A glTF material as glint's: the metallic-roughness material and the extensions glint
 //! reads onto it, its alpha, and which images its texture maps sample, each value checked
-//! (the geometry is read in `gltf.rs`).
+//! (the geometry is read in `primitives.rs`).
 
-use super::gltf::exists;
-use super::{check_emission, check_ior, check_normal_scale, check_reflectance};
+use super::document::exists;
 use crate::kernel::types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
+use crate::scene::mesh::{check_emission, check_ior, check_normal_scale, check_reflectance};
 use crate::scene::texture::Sampling;
 use crate::scene::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
 use glam::Vec3;

@@ -3,8 +3,8 @@
 //! radians) and may give an aspect ratio (width / height). `znear` and `zfar` do not apply to
 //! a path tracer and are ignored.
 
-use super::gltf::{exists, read_document};
-use super::gltf_nodes::placed_nodes;
+use super::document::{exists, read_document};
+use super::nodes::placed_nodes;
 use crate::scene::limits::{MAX_COORDINATE, MIN_SINE};
 use glam::Vec3;
 use gltf::json;

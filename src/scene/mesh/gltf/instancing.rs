@@ -2,10 +2,11 @@
 //! `TRANSLATION`, `ROTATION` and `SCALE` accessors (each optional, all of one count). Each
 //! instance's transform is the node's world transform times the instance's T·R·S, as a
 //! node's own. Like nodes that reuse a mesh, the instances share its geometry, read once
-//! (`gltf.rs`), and are stored once where its material allows (`reuse.rs`), else copied. Attributes whose names start
+//! (`primitives.rs`), and are stored once where its material allows (`reuse.rs`), else copied. Attributes whose names start
 //! with `_` are the application's own and are ignored, as the extension allows.
 
-use super::gltf::{exists, Decoder};
+use super::accessor::Decoder;
+use super::document::exists;
 use glam::{Mat4, Quat, Vec3};
 use gltf::json;
 use json::accessor::Type;

@@ -1,8 +1,8 @@
 //! A glTF file's node hierarchy: which nodes the default scene places, and where. Meshes
-//! (`gltf.rs`), cameras (`gltf_cameras.rs`) and punctual lights (`gltf_lights.rs`) hang from
+//! (`primitives.rs`), cameras (`cameras.rs`) and punctual lights (`lights.rs`) hang from
 //! these nodes.
 
-use super::gltf::exists;
+use super::document::exists;
 use glam::{Mat4, Quat, Vec3};
 use gltf::json;
 
