@@ -98,7 +98,7 @@ fn checked(name: &str, value: Option<i64>, min: i64, max: i64) -> PyResult<Optio
 struct Rendered {
     mean: glint::image::output::Image,
     variance: Option<glint::image::output::Image>,
-    aovs: Option<glint::render::aov::Aovs>,
+    aovs: Option<glint::image::aov::Aovs>,
     /// With denoise: OIDN's image of `mean` and the seconds it took.
     denoised: Option<(glint::image::output::Image, f64)>,
     spp: u32,

@@ -13,6 +13,7 @@ use super::loop_budget::{
 use super::tiles::{next_tile, TilePlanner};
 use super::traversal::Traversal;
 use super::upload::{check_storage_binding_count, ImageSizes, SceneBuffers};
+use crate::image::aov::Aovs;
 use crate::image::output::Image;
 use crate::kernel::source::{
     render_kernel_source_with_texels, ParamsBinding, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
@@ -23,7 +24,6 @@ use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
 use crate::render::accumulation::Accumulation;
-use crate::render::aov::Aovs;
 use crate::render::{check_size, Renderer};
 use anyhow::{anyhow, Result};
 use wgpu::util::DeviceExt;

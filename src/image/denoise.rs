@@ -13,8 +13,8 @@
 //!    `python3`, then looked for in the usual site-packages folders;
 //! 4. the system's library path (`libOpenImageDenoise.so.2`).
 
+use crate::image::aov::Aovs;
 use crate::image::output::Image;
-use crate::render::aov::Aovs;
 use anyhow::{anyhow, Result};
 use std::ffi::{c_char, c_void, CStr};
 use std::path::{Path, PathBuf};

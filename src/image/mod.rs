@@ -1,7 +1,9 @@
 //! What a render becomes: images in files (PNG, EXR: `output`), written atomically after every
 //! output was checked up front (`atomic_write`, `output_check`), tone mapped for display
-//! (`tonemap`), denoised (`denoise`) and compared (`compare`).
+//! (`tonemap`), denoised with the auxiliary images a render gives (`denoise`, `aov`) and compared
+//! (`compare`).
 
+pub mod aov;
 pub mod atomic_write;
 pub mod compare;
 pub mod denoise;

@@ -3,16 +3,15 @@
 //! count or the time limit is reached.
 
 pub mod accumulation;
-pub mod aov;
 pub mod bench;
 pub mod interrupt;
 pub mod merge;
 pub mod partial;
 
-use crate::cpu::integrator::accumulate::next_block_end;
+use crate::image::aov::Aovs;
 use crate::image::output::Image;
+use crate::kernel::schedule::next_block_end;
 use crate::render::accumulation::Accumulation;
-use crate::render::aov::Aovs;
 use anyhow::{anyhow, Result};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};

@@ -3,9 +3,9 @@
 //! the progressive render goes on meanwhile. [`RefreshSchedule`] decides when to start one and
 //! whether a finished one may be shown; it is pure, so it is tested without a window or OIDN.
 
+use crate::image::aov::Aovs;
 use crate::image::denoise::{self, Oidn};
 use crate::image::output::Image;
-use crate::render::aov::Aovs;
 use crate::render::Renderer;
 use anyhow::Result;
 use std::sync::mpsc;

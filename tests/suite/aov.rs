@@ -7,9 +7,9 @@
 use crate::common;
 use common::{gpu, kernel_scene, PathAgreement};
 use glint::gpu::GpuRenderer;
+use glint::image::aov::{Aovs, BACKGROUND_DEPTH};
 use glint::image::output::Image;
 use glint::kernel::KernelScene;
-use glint::render::aov::{Aovs, BACKGROUND_DEPTH};
 use glint::render::render_image;
 
 /// Renders `spp` samples in batches of `batch` with AOVs on, on the CPU and (where there is

@@ -6,17 +6,15 @@
 //! 2, 4, …, [`MERGE_BLOCK`], and then after every multiple of it. Within a block the samples
 //! are added by Welford's update; at the block's end the block is merged into the totals by
 //! Chan, Golub and LeVeque's pairwise update, which keeps the mean accurate in f32 at millions
-//! of samples. Since batches are split only at block ends ([`next_block_end`]), the floats
+//! of samples. Since batches are split only at block ends (`kernel::schedule`), the floats
 //! depend on the sample indices alone: any batching gives the same bytes.
 
+use crate::kernel::schedule::is_block_end;
 use glam::Vec3;
 
 /// Largest sample value (per channel) taken. With at most 2³⁰ samples, M2 stays below
 /// 2³⁰ · (2·10¹⁴)² < 4.3·10³⁷, so it cannot overflow f32.
 pub const MAX_SAMPLE: f32 = 1e14;
-/// Block size of the merge schedule once a pixel has this many samples.
-pub const MERGE_BLOCK: u32 = 64;
-
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Accumulator {
     /// Totals over the merged blocks.
@@ -38,24 +36,6 @@ pub fn accumulator_start(count: u32, mean: Vec3, m2: Vec3) -> Accumulator {
         m2,
         ..Default::default()
     }
-}
-
-/// Whether a block of the merge schedule ends once a pixel has `samples` samples (≥ 1).
-pub fn is_block_end(samples: u32) -> bool {
-    if samples >= MERGE_BLOCK {
-        return samples.is_multiple_of(MERGE_BLOCK);
-    }
-    samples & (samples - 1) == 0
-}
-
-/// The first block end after `samples` that is at least `samples + wanted` (at most
-/// [`MERGE_BLOCK`] − 1 more), or `limit` if that comes first: where a batch may end.
-pub fn next_block_end(samples: u32, wanted: u32, limit: u32) -> u32 {
-    let mut end = samples.saturating_add(wanted.max(1)).min(limit);
-    while end < limit && !is_block_end(end) {
-        end += 1;
-    }
-    end
 }
 
 /// Whether every channel is finite and at most [`MAX_SAMPLE`] in magnitude (compared as bit
@@ -104,6 +84,7 @@ pub fn merge_block(acc: &mut Accumulator) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::schedule::{next_block_end, MERGE_BLOCK};
 
     #[test]
     fn the_kernel_bound_is_the_bit_pattern_of_max_sample() {

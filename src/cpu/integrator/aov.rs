@@ -4,12 +4,9 @@
 
 use crate::cpu::geometry::hit::Hit;
 use crate::cpu::materials::material::is_delta;
+use crate::image::aov::BACKGROUND_DEPTH;
 use crate::kernel::types::{Material, Params};
 use glam::Vec3;
-
-/// Depth of a camera ray that leaves the scene: +inf stands for it, as a finite value, so
-/// running means stay finite.
-pub const BACKGROUND_DEPTH: f32 = 1e30;
 
 /// Whether the render is asked for AOVs (the kernel also needs them compiled in).
 pub fn aovs_on(params: &Params) -> bool {

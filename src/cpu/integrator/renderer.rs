@@ -2,11 +2,11 @@
 
 use crate::cpu::integrator::trace::{render_pixel, PixelStats};
 use crate::cpu::scene_refs::SceneRefs;
+use crate::image::aov::Aovs;
 use crate::image::output::Image;
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
 use crate::render::accumulation::Accumulation;
-use crate::render::aov::Aovs;
 use crate::render::{check_size, Renderer};
 use anyhow::{anyhow, Result};
 use rayon::prelude::*;

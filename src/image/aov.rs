@@ -4,8 +4,9 @@
 
 use crate::image::output::Image;
 
-/// Depth written for camera rays that leave the scene (+inf, as a large finite value).
-pub use crate::cpu::integrator::aov::BACKGROUND_DEPTH;
+/// Depth of a camera ray that leaves the scene: +inf stands for it, as a finite value, so
+/// running means stay finite (the kernel's `shaders/integrator/aov.wgsl` has the same).
+pub const BACKGROUND_DEPTH: f32 = 1e30;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Aovs {
