@@ -50,46 +50,11 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     var hit = intersect_scene(ray);
     segments += 1u;
     if hit.t == NO_HIT {
-        var escaped = params.background;
-        if HAS_ENVIRONMENT {
-            escaped = environment_radiance(ray.dir);
-        }
-        if aovs_on() {
-            (*path).aov = aov_record_miss((*path).aov, escaped);
-        }
-        if HAS_ENVIRONMENT {
-            // The map is an emitter like the others: a BSDF-sampled ray that reaches it
-            // shares its light with next-event estimation from the previous vertex.
-            if light_sampling && !(*path).came_from_delta {
-                let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, PRIMITIVE_ENVIRONMENT, 0u);
-                escaped *= power_heuristic((*path).bsdf_pdf_of_ray, pdf);
-            }
-        }
-        if HAS_SUN_DISKS {
-            let mis = light_sampling && !(*path).came_from_delta;
-            escaped += sun_disks_radiance(ray.dir, (*path).bsdf_pdf_of_ray, mis);
-        }
-        (*path).radiance += firefly_clamp((*path).throughput * escaped, bounce);
+        add_escaped_light(path, light_sampling);
         return true;
     }
     let m = vertex_colored(material_at(materials[hit.material], hit.uv), hit);
-    // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
-    // else the unmapped one; the base's normal map does not reach it. Normalised again (the
-    // same vector but for rounding) so that no kernel variant can prove it the base's and
-    // merge the coat's arithmetic with the base's: every variant rounds the coat alike
-    // (tests/suite/scene_binding.rs). Only where a coat is compiled in: nothing else reads it.
-    var coat_normal = hit.shading_normal;
-    if HAS_CLEARCOAT {
-        coat_normal = normalize(coat_normal);
-    }
-    if HAS_TEXTURES && hit.primitive == PRIMITIVE_TRIANGLE {
-        if HAS_CLEARCOAT && m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
-            coat_normal = normal_mapped(hit, m.clearcoat_normal_texture, m.clearcoat_normal_scale, -ray.dir);
-        }
-        if m.normal_texture != NO_TEXTURE {
-            hit.shading_normal = normal_mapped(hit, m.normal_texture, m.normal_scale, -ray.dir);
-        }
-    }
+    let coat_normal = apply_normal_maps(m, &hit, -ray.dir);
     if aovs_on() {
         (*path).aov = aov_record_hit((*path).aov, bounce, hit, m);
     }
@@ -97,45 +62,144 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         // The segment ran inside the volume this surface bounds (volume.wgsl).
         (*path).throughput *= volume_transmittance(m, hit.t);
     }
+    add_hit_emission(path, m, hit, light_sampling);
+    // max_bounces counts scattering events; this also bounds every path's length.
+    if bounce >= params.max_bounces {
+        return true;
+    }
+    let origin = offset_ray_origin(hit.position, hit.error, hit.normal);
+    if light_sampling && !is_delta(m) {
+        add_light_sample(path, m, hit, coat_normal, origin, pixel, sample);
+    }
+    return scatter(path, m, hit, coat_normal, pixel, sample);
+}
+
+// The path's ray left the scene: the background or the environment map, and the sun disks,
+// weighted against next-event estimation from the previous vertex.
+fn add_escaped_light(path: ptr<function, PathState>, light_sampling: bool) {
+    let ray = (*path).ray;
+    var escaped = params.background;
+    if HAS_ENVIRONMENT {
+        escaped = environment_radiance(ray.dir);
+    }
+    if aovs_on() {
+        (*path).aov = aov_record_miss((*path).aov, escaped);
+    }
+    if HAS_ENVIRONMENT {
+        // The map is an emitter like the others: a BSDF-sampled ray that reaches it
+        // shares its light with next-event estimation from the previous vertex.
+        if light_sampling && !(*path).came_from_delta {
+            let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, PRIMITIVE_ENVIRONMENT, 0u);
+            escaped *= power_heuristic((*path).bsdf_pdf_of_ray, pdf);
+        }
+    }
+    if HAS_SUN_DISKS {
+        let mis = light_sampling && !(*path).came_from_delta;
+        escaped += sun_disks_radiance(ray.dir, (*path).bsdf_pdf_of_ray, mis);
+    }
+    (*path).radiance += firefly_clamp((*path).throughput * escaped, (*path).bounce);
+}
+
+// The material's normal maps at a triangle hit: the base's replaces the hit's shading normal;
+// returns the pbr coat's own shading normal (KHR_materials_clearcoat): its
+// clearcoatNormalTexture, else the unmapped one, since the base's normal map does not reach it.
+// That one is normalised again (the same vector but for rounding) so that no kernel variant can
+// prove it the base's and merge the coat's arithmetic with the base's: every variant rounds the
+// coat alike (tests/suite/scene_binding.rs). Only where a coat is compiled in: nothing else
+// reads it.
+fn apply_normal_maps(m: Material, hit: ptr<function, Hit>, wo: vec3<f32>) -> vec3<f32> {
+    var coat_normal = (*hit).shading_normal;
+    if HAS_CLEARCOAT {
+        coat_normal = normalize(coat_normal);
+    }
+    if HAS_TEXTURES && (*hit).primitive == PRIMITIVE_TRIANGLE {
+        if HAS_CLEARCOAT && m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
+            coat_normal = normal_mapped(*hit, m.clearcoat_normal_texture, m.clearcoat_normal_scale, wo);
+        }
+        if m.normal_texture != NO_TEXTURE {
+            (*hit).shading_normal = normal_mapped(*hit, m.normal_texture, m.normal_scale, wo);
+        }
+    }
+    return coat_normal;
+}
+
+// The light the hit surface emits towards the path. An emitter hit by a BSDF-sampled ray
+// shares its light with next-event estimation from the previous vertex; camera rays and delta
+// bounces count in full.
+fn add_hit_emission(path: ptr<function, PathState>, m: Material, hit: Hit, light_sampling: bool) {
     if any(m.emission > vec3<f32>(0.0)) {
-        // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
-        // from the previous vertex; camera rays and delta bounces count in full.
+        let ray = (*path).ray;
         var weight = 1.0;
         if light_sampling && !(*path).came_from_delta {
             let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
             weight = power_heuristic((*path).bsdf_pdf_of_ray, pdf);
         }
-        (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, bounce);
+        (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, (*path).bounce);
     }
-    // max_bounces counts scattering events; this also bounds every path's length.
-    if bounce >= params.max_bounces {
-        return true;
+}
+
+// Next-event estimation: light arriving after one more scattering event, through a shadow ray
+// from `origin`, weighted against BSDF sampling.
+fn add_light_sample(
+    path: ptr<function, PathState>,
+    m: Material,
+    hit: Hit,
+    coat_normal: vec3<f32>,
+    origin: vec3<f32>,
+    pixel: u32,
+    sample: u32,
+) {
+    var light_rng = rng_init(pixel, sample, stream_id((*path).bounce, PURPOSE_LIGHT), params.seed);
+    let light = sample_light(hit.position, origin, &light_rng);
+    if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
+        add_unblocked_light(path, m, hit, coat_normal, origin, light, pixel, sample);
     }
+}
+
+// The sampled light's contribution if the BSDF passes it and nothing blocks the shadow ray.
+fn add_unblocked_light(
+    path: ptr<function, PathState>,
+    m: Material,
+    hit: Hit,
+    coat_normal: vec3<f32>,
+    origin: vec3<f32>,
+    light: LightSample,
+    pixel: u32,
+    sample: u32,
+) {
+    let bounce = (*path).bounce;
+    let wo = -(*path).ray.dir;
+    let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
+    if !any(f_cos > vec3<f32>(0.0)) {
+        return;
+    }
+    segments += 1u;
+    if HAS_ALPHA {
+        // The shadow ray leaves this vertex as the next bounce's ray will: the same segment's
+        // key, so both see the same blended triangles.
+        alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
+    }
+    if light_visible(Ray(origin, light.dir), light) {
+        let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
+        let weight = nee_weight(light, pdf);
+        let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
+        (*path).radiance += firefly_clamp(contribution, bounce + 1u);
+    }
+}
+
+// Samples the BSDF for the path's next ray, with Russian roulette from params.roulette_start;
+// true when the path ends here.
+fn scatter(
+    path: ptr<function, PathState>,
+    m: Material,
+    hit: Hit,
+    coat_normal: vec3<f32>,
+    pixel: u32,
+    sample: u32,
+) -> bool {
+    let bounce = (*path).bounce;
     let p = hit.position;
-    let wo = -ray.dir;
-    let origin = offset_ray_origin(p, hit.error, hit.normal);
-    if light_sampling && !is_delta(m) {
-        // Next-event estimation: light arriving after one more scattering event.
-        var light_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
-        let light = sample_light(p, origin, &light_rng);
-        if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
-            let f_cos = bsdf_eval(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
-            if any(f_cos > vec3<f32>(0.0)) {
-                segments += 1u;
-                if HAS_ALPHA {
-                    // The shadow ray leaves this vertex as the next bounce's ray will: the same
-                    // segment's key, so both see the same blended triangles.
-                    alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
-                }
-                if light_visible(Ray(origin, light.dir), light) {
-                    let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
-                    let weight = nee_weight(light, pdf);
-                    let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
-                    (*path).radiance += firefly_clamp(contribution, bounce + 1u);
-                }
-            }
-        }
-    }
+    let wo = -(*path).ray.dir;
     var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
     let s = bsdf_sample(m, wo, hit.shading_normal, coat_normal, hit.front_face, &bsdf_rng);
     var throughput = (*path).throughput * s.weight;

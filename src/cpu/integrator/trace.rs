@@ -4,7 +4,7 @@ use crate::cpu::core::camera::camera_ray;
 use crate::cpu::core::ray::Ray;
 use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use crate::cpu::geometry::alpha::alpha_segment_key;
-use crate::cpu::geometry::hit::NO_HIT;
+use crate::cpu::geometry::hit::{Hit, NO_HIT};
 use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene};
 use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::integrator::accumulate::{accumulator_start, add_sample, merge_block};
@@ -13,7 +13,7 @@ use crate::cpu::integrator::aov::{
 };
 use crate::cpu::integrator::volume::volume_transmittance;
 use crate::cpu::lights::environment::environment_radiance;
-use crate::cpu::lights::light_sample::{nee_weight, power_heuristic};
+use crate::cpu::lights::light_sample::{nee_weight, power_heuristic, LightSample};
 use crate::cpu::lights::punctual::sun_disks_radiance;
 use crate::cpu::lights::sampling::{light_pdf, light_visible, sample_light};
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
@@ -21,7 +21,9 @@ use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::normal_map::normal_mapped;
 use crate::cpu::textures::texture::material_at;
 use crate::cpu::textures::vertex_color::vertex_colored;
-use crate::kernel::types::{Params, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE};
+use crate::kernel::types::{
+    Material, Params, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_TRIANGLE,
+};
 use glam::Vec3;
 
 /// A path in flight: what one more segment needs.
@@ -92,35 +94,7 @@ pub fn path_step(
     let mut hit = intersect_scene(&scene.geometry, &ray);
     *segments += 1;
     if hit.t == NO_HIT {
-        // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
-        let mut escaped = Vec3::from(params.background);
-        if params.environment_width > 0 {
-            escaped = environment_radiance(scene, ray.dir);
-        }
-        if aovs_on(params) {
-            aov_record_miss(&mut path.aov, escaped);
-        }
-        if params.environment_width > 0 {
-            // The map is an emitter like the others: a BSDF-sampled ray that reaches it
-            // shares its light with next-event estimation from the previous vertex.
-            if light_sampling && !path.came_from_delta {
-                let pdf = light_pdf(
-                    scene,
-                    path.ray_start,
-                    ray.origin,
-                    ray.dir,
-                    PRIMITIVE_ENVIRONMENT,
-                    0,
-                );
-                escaped *= power_heuristic(path.bsdf_pdf_of_ray, pdf);
-            }
-        }
-        // The kernel compiles sun disks in only for scenes that have one (HAS_SUN_DISKS).
-        if params.light_count > 0 {
-            let mis = light_sampling && !path.came_from_delta;
-            escaped += sun_disks_radiance(scene, ray.dir, path.bsdf_pdf_of_ray, mis);
-        }
-        path.radiance += firefly_clamp(params, path.throughput * escaped, bounce);
+        add_escaped_light(scene, path, light_sampling);
         return true;
     }
     // The material as stored, unless textures or vertex colours change it at this hit (the
@@ -137,9 +111,82 @@ pub fn path_step(
         );
         &varied
     };
-    // The pbr coat's own shading normal (KHR_materials_clearcoat): its clearcoatNormalTexture,
-    // else the unmapped one; the base's normal map does not reach it. Normalised again as the
-    // kernel does (shaders/integrator/trace.wgsl says why), where there is a coat: nothing else reads it.
+    let coat_normal = apply_normal_maps(scene, m, &mut hit, -ray.dir);
+    if aovs_on(params) {
+        aov_record_hit(&mut path.aov, bounce, &hit, m);
+    }
+    // The kernel compiles this in only for scenes with attenuating volumes (HAS_VOLUME).
+    if !hit.front_face {
+        path.throughput *= volume_transmittance(m, hit.t);
+    }
+    add_hit_emission(scene, path, m, &hit, light_sampling);
+    // max_bounces counts scattering events; this also bounds every path's length.
+    if bounce >= params.max_bounces {
+        return true;
+    }
+    let vertex = Vertex {
+        material: m,
+        hit: &hit,
+        coat_normal,
+        origin: offset_ray_origin(hit.position, hit.error, hit.normal),
+    };
+    if light_sampling && !is_delta(m) {
+        add_light_sample(scene, path, &vertex, pixel, sample, segments);
+    }
+    scatter(params, path, &vertex, pixel, sample)
+}
+
+/// A scattering vertex: the material there, the hit with its mapped shading normal, the coat's
+/// own normal and the origin of rays leaving on the geometric normal's side.
+struct Vertex<'a> {
+    material: &'a Material,
+    hit: &'a Hit,
+    coat_normal: Vec3,
+    origin: Vec3,
+}
+
+/// The path's ray left the scene: the background or the environment map, and the sun disks,
+/// weighted against next-event estimation from the previous vertex.
+fn add_escaped_light(scene: &SceneRefs, path: &mut PathState, light_sampling: bool) {
+    let params = scene.params;
+    let ray = path.ray;
+    // The kernel compiles the map in only for scenes that have one (HAS_ENVIRONMENT).
+    let mut escaped = Vec3::from(params.background);
+    if params.environment_width > 0 {
+        escaped = environment_radiance(scene, ray.dir);
+    }
+    if aovs_on(params) {
+        aov_record_miss(&mut path.aov, escaped);
+    }
+    if params.environment_width > 0 {
+        // The map is an emitter like the others: a BSDF-sampled ray that reaches it
+        // shares its light with next-event estimation from the previous vertex.
+        if light_sampling && !path.came_from_delta {
+            let pdf = light_pdf(
+                scene,
+                path.ray_start,
+                ray.origin,
+                ray.dir,
+                PRIMITIVE_ENVIRONMENT,
+                0,
+            );
+            escaped *= power_heuristic(path.bsdf_pdf_of_ray, pdf);
+        }
+    }
+    // The kernel compiles sun disks in only for scenes that have one (HAS_SUN_DISKS).
+    if params.light_count > 0 {
+        let mis = light_sampling && !path.came_from_delta;
+        escaped += sun_disks_radiance(scene, ray.dir, path.bsdf_pdf_of_ray, mis);
+    }
+    path.radiance += firefly_clamp(params, path.throughput * escaped, path.bounce);
+}
+
+/// The material's normal maps at a triangle hit: the base's replaces `hit`'s shading normal;
+/// returns the pbr coat's own shading normal (KHR_materials_clearcoat): its
+/// clearcoatNormalTexture, else the unmapped one, since the base's normal map does not reach
+/// it. That one is normalised again as the kernel does (shaders/integrator/trace.wgsl says
+/// why), where there is a coat: nothing else reads it.
+fn apply_normal_maps(scene: &SceneRefs, m: &Material, hit: &mut Hit, wo: Vec3) -> Vec3 {
     let mut coat_normal = hit.shading_normal;
     if m.clearcoat > 0.0 {
         coat_normal = coat_normal.normalize();
@@ -148,35 +195,40 @@ pub fn path_step(
         if m.clearcoat > 0.0 && m.clearcoat_normal_texture != NO_TEXTURE {
             coat_normal = normal_mapped(
                 &scene.textures(),
-                &hit,
+                hit,
                 m.clearcoat_normal_texture,
                 m.clearcoat_normal_scale,
                 &scene.triangle_tangents[hit.index as usize],
-                -ray.dir,
+                wo,
             );
         }
         if m.normal_texture != NO_TEXTURE {
             hit.shading_normal = normal_mapped(
                 &scene.textures(),
-                &hit,
+                hit,
                 m.normal_texture,
                 m.normal_scale,
                 &scene.triangle_tangents[hit.index as usize],
-                -ray.dir,
+                wo,
             );
         }
     }
-    if aovs_on(params) {
-        aov_record_hit(&mut path.aov, bounce, &hit, m);
-    }
-    // The kernel compiles this in only for scenes with attenuating volumes (HAS_VOLUME).
-    if !hit.front_face {
-        path.throughput *= volume_transmittance(m, hit.t);
-    }
+    coat_normal
+}
+
+/// The light the hit surface emits towards the path. An emitter hit by a BSDF-sampled ray
+/// shares its light with next-event estimation from the previous vertex; camera rays and delta
+/// bounces count in full.
+fn add_hit_emission(
+    scene: &SceneRefs,
+    path: &mut PathState,
+    m: &Material,
+    hit: &Hit,
+    light_sampling: bool,
+) {
     let emission = Vec3::from(m.emission);
     if emission.cmpgt(Vec3::ZERO).any() {
-        // An emitter hit by a BSDF-sampled ray shares its light with next-event estimation
-        // from the previous vertex; camera rays and delta bounces count in full.
+        let ray = path.ray;
         let mut weight = 1.0;
         if light_sampling && !path.came_from_delta {
             let pdf = light_pdf(
@@ -189,72 +241,113 @@ pub fn path_step(
             );
             weight = power_heuristic(path.bsdf_pdf_of_ray, pdf);
         }
-        path.radiance += firefly_clamp(params, path.throughput * emission * weight, bounce);
+        path.radiance += firefly_clamp(
+            scene.params,
+            path.throughput * emission * weight,
+            path.bounce,
+        );
     }
-    // max_bounces counts scattering events; this also bounds every path's length.
-    if bounce >= params.max_bounces {
-        return true;
+}
+
+/// Next-event estimation: light arriving after one more scattering event, through a shadow
+/// ray, weighted against BSDF sampling.
+fn add_light_sample(
+    scene: &SceneRefs,
+    path: &mut PathState,
+    vertex: &Vertex,
+    pixel: u32,
+    sample: u32,
+    segments: &mut u32,
+) {
+    let params = scene.params;
+    let hit = vertex.hit;
+    let stream = stream_id(path.bounce, PURPOSE_LIGHT);
+    let mut light_rng = Rng::new(pixel, sample, stream, params.seed);
+    let light = sample_light(scene, hit.position, vertex.origin, &mut light_rng);
+    if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
+        add_unblocked_light(scene, path, vertex, &light, pixel, sample, segments);
     }
+}
+
+/// The sampled light's contribution if the BSDF passes it and nothing blocks the shadow ray.
+fn add_unblocked_light(
+    scene: &SceneRefs,
+    path: &mut PathState,
+    vertex: &Vertex,
+    light: &LightSample,
+    pixel: u32,
+    sample: u32,
+    segments: &mut u32,
+) {
+    let params = scene.params;
+    let (m, hit) = (vertex.material, vertex.hit);
+    let bounce = path.bounce;
+    let wo = -path.ray.dir;
+    let f_cos = bsdf_eval(
+        m,
+        wo,
+        light.dir,
+        hit.shading_normal,
+        vertex.coat_normal,
+        hit.front_face,
+    );
+    if !f_cos.cmpgt(Vec3::ZERO).any() {
+        return;
+    }
+    let shadow = Ray {
+        origin: vertex.origin,
+        dir: light.dir,
+    };
+    *segments += 1;
+    // The shadow ray leaves this vertex as the next bounce's ray will: the same segment's key,
+    // so both see the same blended triangles.
+    let keyed;
+    let shadow_scene = if scene.has_alpha() {
+        let key = alpha_segment_key(params, pixel, sample, bounce + 1);
+        keyed = scene.with_alpha_key(key);
+        &keyed
+    } else {
+        scene
+    };
+    if light_visible(shadow_scene, &shadow, light) {
+        let pdf = bsdf_pdf(
+            m,
+            wo,
+            light.dir,
+            hit.shading_normal,
+            vertex.coat_normal,
+            hit.front_face,
+        );
+        let weight = nee_weight(light, pdf);
+        let contribution = path.throughput * f_cos * light.radiance * (weight / light.pdf);
+        path.radiance += firefly_clamp(params, contribution, bounce + 1);
+    }
+}
+
+/// Samples the BSDF for the path's next ray, with Russian roulette from
+/// `params.roulette_start`; true when the path ends here.
+fn scatter(
+    params: &Params,
+    path: &mut PathState,
+    vertex: &Vertex,
+    pixel: u32,
+    sample: u32,
+) -> bool {
+    let (m, hit) = (vertex.material, vertex.hit);
+    let bounce = path.bounce;
     let p = hit.position;
-    let wo = -ray.dir;
-    let origin = offset_ray_origin(p, hit.error, hit.normal);
-    if light_sampling && !is_delta(m) {
-        // Next-event estimation: light arriving after one more scattering event.
-        let mut light_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_LIGHT), params.seed);
-        let light = sample_light(scene, p, origin, &mut light_rng);
-        if light.pdf > 0.0 && !crosses_shading_side(light.dir, &hit) {
-            let f_cos = bsdf_eval(
-                m,
-                wo,
-                light.dir,
-                hit.shading_normal,
-                coat_normal,
-                hit.front_face,
-            );
-            if f_cos.cmpgt(Vec3::ZERO).any() {
-                let shadow = Ray {
-                    origin,
-                    dir: light.dir,
-                };
-                *segments += 1;
-                // The shadow ray leaves this vertex as the next bounce's ray will: the same
-                // segment's key, so both see the same blended triangles.
-                let keyed;
-                let shadow_scene = if scene.has_alpha() {
-                    let key = alpha_segment_key(params, pixel, sample, bounce + 1);
-                    keyed = scene.with_alpha_key(key);
-                    &keyed
-                } else {
-                    scene
-                };
-                if light_visible(shadow_scene, &shadow, &light) {
-                    let pdf = bsdf_pdf(
-                        m,
-                        wo,
-                        light.dir,
-                        hit.shading_normal,
-                        coat_normal,
-                        hit.front_face,
-                    );
-                    let weight = nee_weight(&light, pdf);
-                    let contribution =
-                        path.throughput * f_cos * light.radiance * (weight / light.pdf);
-                    path.radiance += firefly_clamp(params, contribution, bounce + 1);
-                }
-            }
-        }
-    }
+    let wo = -path.ray.dir;
     let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
     let s = bsdf_sample(
         m,
         wo,
         hit.shading_normal,
-        coat_normal,
+        vertex.coat_normal,
         hit.front_face,
         &mut bsdf_rng,
     );
     let mut throughput = path.throughput * s.weight;
-    if throughput == Vec3::ZERO || crosses_shading_side(s.dir, &hit) {
+    if throughput == Vec3::ZERO || crosses_shading_side(s.dir, hit) {
         return true;
     }
     if bounce >= params.roulette_start {
