@@ -1,7 +1,8 @@
 //! Finding the closest hit along a ray (`shaders/traverse/`): the scene's binary BVH (`bvh`),
-//! the instances' own trees (`blas`) and the 4-wide tree (`wide`). Which tree a device runs is
+//! the instances' own trees (`blas`), both by one walk (`binary_walk`), and the 4-wide tree (`wide`). Which tree a device runs is
 //! chosen once, in `kernel::bvh::layout`.
 
+pub mod binary_walk;
 pub mod blas;
 pub mod bvh;
 pub mod bvh_ray;
