@@ -8,9 +8,8 @@ use crate::cpu::geometry::scene_geometry::Geometry;
 use crate::cpu::textures::texture::Textures;
 use crate::kernel::bvh::layout::BvhLayout;
 use crate::kernel::types::{
-    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
-    Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
-    TriangleUvs,
+    Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Texture, TriangleColors,
+    TriangleTangents,
 };
 use crate::kernel::variant::has_alpha;
 use crate::kernel::KernelScene;
@@ -19,26 +18,11 @@ use crate::kernel::KernelScene;
 #[derive(Clone, Copy)]
 pub struct SceneRefs<'a> {
     pub params: &'a Params,
-    pub spheres: &'a [Sphere],
-    pub quads: &'a [Quad],
     pub materials: &'a [Material],
     pub emitters: &'a [Emitter],
-    pub triangles: &'a [Triangle],
-    pub triangle_normals: &'a [TriangleNormals],
-    /// Empty: every ray tests every primitive.
-    pub bvh_nodes: &'a [BvhNode],
-    pub bvh_primitives: &'a [u32],
-    /// Empty: no instanced meshes.
-    pub instances: &'a [Instance],
-    /// The 4-wide tree where the CPU traverses it (src/kernel/bvh/layout.rs), else empty.
-    pub bvh_wide_nodes: &'a [BvhWideNode],
     /// Texture descriptors and texels (`texture.rs`); empty without textures.
     pub textures: &'a [Texture],
     pub texels: &'a [[f32; 4]],
-    pub triangle_uvs: &'a [TriangleUvs],
-    /// The second set (glTF's TEXCOORD_1), one per triangle when a texture reads it, else
-    /// empty.
-    pub triangle_uvs1: &'a [TriangleUvs],
     /// One per triangle when a material has a normal map, else empty.
     pub triangle_tangents: &'a [TriangleTangents],
     /// One per triangle when a mesh has vertex colours, else empty.
@@ -48,43 +32,58 @@ pub struct SceneRefs<'a> {
     pub environment_alias: &'a [EnvironmentAlias],
     /// Point, spot and directional lights (`punctual.rs`).
     pub lights: &'a [Light],
-    /// What intersection reads: the arrays above, and the key of the ray segment being traced
-    /// (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`. Built once
-    /// here, not per ray: building it for every ray and shadow ray was 3% of a CPU render.
+    /// The surfaces, as intersection reads them: spheres, quads, triangles with their normals
+    /// and texture coordinates, the BVHs and instances, and the key of the ray segment being
+    /// traced (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`.
+    /// Built once here, not per ray: building it for every ray and shadow ray was 3% of a CPU
+    /// render.
     pub geometry: Geometry<'a>,
 }
 
 impl<'a> SceneRefs<'a> {
     /// `scene`'s arrays with `params` in place of its own.
     pub fn of(scene: &'a KernelScene, params: &'a Params) -> SceneRefs<'a> {
-        let mut refs = SceneRefs {
+        let textures = Textures {
+            descriptors: &scene.textures,
+            texels: &scene.texels,
+        };
+        SceneRefs {
             params,
-            spheres: &scene.spheres,
-            quads: &scene.quads,
             materials: &scene.materials,
             emitters: &scene.emitters,
-            triangles: &scene.triangles,
-            triangle_normals: &scene.triangle_normals,
-            bvh_nodes: &scene.bvh_nodes,
-            bvh_primitives: &scene.bvh_primitives,
-            instances: &scene.instances,
-            bvh_wide_nodes: match BvhLayout::for_cpu() {
-                BvhLayout::Wide => &scene.bvh_wide_nodes,
-                BvhLayout::Binary => &[],
-            },
             environment_texels: &scene.environment_texels,
             environment_alias: &scene.environment_alias,
             textures: &scene.textures,
             texels: &scene.texels,
-            triangle_uvs: &scene.triangle_uvs,
-            triangle_uvs1: &scene.triangle_uvs1,
             triangle_tangents: &scene.triangle_tangents,
             triangle_colors: &scene.triangle_colors,
             lights: &scene.lights,
-            geometry: Geometry::default(),
-        };
-        refs.geometry = refs.build_geometry();
-        refs
+            geometry: Geometry {
+                spheres: &scene.spheres,
+                quads: &scene.quads,
+                triangles: &scene.triangles,
+                triangle_normals: &scene.triangle_normals,
+                bvh_nodes: &scene.bvh_nodes,
+                bvh_primitives: &scene.bvh_primitives,
+                instances: &scene.instances,
+                bvh_wide_nodes: match BvhLayout::for_cpu() {
+                    BvhLayout::Wide => &scene.bvh_wide_nodes,
+                    BvhLayout::Binary => &[],
+                },
+                triangle_uvs: &scene.triangle_uvs,
+                triangle_uvs1: &scene.triangle_uvs1,
+                textured: !scene.textures.is_empty(),
+                alpha: AlphaTest {
+                    enabled: has_alpha(&scene.materials),
+                    materials: &scene.materials,
+                    textures,
+                    triangle_uvs: &scene.triangle_uvs,
+                    triangle_uvs1: &scene.triangle_uvs1,
+                    triangle_colors: &scene.triangle_colors,
+                    key: 0,
+                },
+            },
+        }
     }
 
     /// Whether a material is alpha-tested or blended (the kernel's `HAS_ALPHA`, alpha.rs).
@@ -110,30 +109,5 @@ impl<'a> SceneRefs<'a> {
     /// What intersection reads.
     pub fn geometry(&self) -> Geometry<'a> {
         self.geometry
-    }
-
-    fn build_geometry(&self) -> Geometry<'a> {
-        Geometry {
-            spheres: self.spheres,
-            quads: self.quads,
-            triangles: self.triangles,
-            triangle_normals: self.triangle_normals,
-            bvh_nodes: self.bvh_nodes,
-            bvh_primitives: self.bvh_primitives,
-            instances: self.instances,
-            bvh_wide_nodes: self.bvh_wide_nodes,
-            triangle_uvs: self.triangle_uvs,
-            triangle_uvs1: self.triangle_uvs1,
-            textured: !self.textures.is_empty(),
-            alpha: AlphaTest {
-                enabled: has_alpha(self.materials),
-                materials: self.materials,
-                textures: self.textures(),
-                triangle_uvs: self.triangle_uvs,
-                triangle_uvs1: self.triangle_uvs1,
-                triangle_colors: self.triangle_colors,
-                key: 0,
-            },
-        }
     }
 }

@@ -114,7 +114,7 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
     }
     if e.primitive == PRIMITIVE_TRIANGLE {
         // Uniform on the triangle's area.
-        let tri = &scene.triangles[e.index as usize];
+        let tri = &scene.geometry.triangles[e.index as usize];
         let b = triangle_sample_barycentrics(u);
         let to_light = triangle_point(tri, b) - p;
         let t = to_light.length();
@@ -127,7 +127,12 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         // The emission where the sample lies (glTF's emissive texture).
         let m = &scene.materials[tri.material as usize];
         let emission = if m.emission_texture != NO_TEXTURE {
-            let uv = triangle_uv(scene.triangle_uvs, scene.triangle_uvs1, e.index, b);
+            let uv = triangle_uv(
+                scene.geometry.triangle_uvs,
+                scene.geometry.triangle_uvs1,
+                e.index,
+                b,
+            );
             emission_at(&scene.textures(), m, uv)
         } else {
             Vec3::from(m.emission)
@@ -136,7 +141,7 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         return out;
     }
     if e.primitive == PRIMITIVE_QUAD {
-        let q = &scene.quads[e.index as usize];
+        let q = &scene.geometry.quads[e.index as usize];
         let to_light =
             Vec3::from(q.corner) + u.0 * Vec3::from(q.edge_u) + u.1 * Vec3::from(q.edge_v) - p;
         let t = to_light.length();
@@ -148,7 +153,7 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         out.radiance = Vec3::from(scene.materials[q.material as usize].emission);
         return out;
     }
-    let s = &scene.spheres[e.index as usize];
+    let s = &scene.geometry.spheres[e.index as usize];
     out.radiance = Vec3::from(scene.materials[s.material as usize].emission);
     if sphere_contains(s, probe) {
         // Uniform on the sphere's area; from inside, every direction meets it exactly once.
@@ -195,7 +200,7 @@ pub fn light_pdf(
         return scene.params.environment_light_probability * environment_pdf(scene, dir);
     }
     if primitive == PRIMITIVE_TRIANGLE {
-        let tri = &scene.triangles[index as usize];
+        let tri = &scene.geometry.triangles[index as usize];
         let normal = triangle_normal(tri);
         let t = triangle_plane_distance(tri, normal, p, dir);
         #[allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -205,7 +210,7 @@ pub fn light_pdf(
         return tri.light_probability * area_to_solid_angle(t, normal.dot(dir), tri.area);
     }
     if primitive == PRIMITIVE_QUAD {
-        let q = &scene.quads[index as usize];
+        let q = &scene.geometry.quads[index as usize];
         let normal = Vec3::from(q.normal);
         let cos_light = normal.dot(dir);
         let t = (q.plane_offset - normal.dot(p)) / cos_light;
@@ -215,7 +220,7 @@ pub fn light_pdf(
         }
         return q.light_probability * area_to_solid_angle(t, cos_light, q.area);
     }
-    let s = &scene.spheres[index as usize];
+    let s = &scene.geometry.spheres[index as usize];
     if sphere_contains(s, probe) {
         let (t, cos_exit) = sphere_chord(s, p, dir);
         #[allow(clippy::neg_cmp_op_on_partial_ord)]
