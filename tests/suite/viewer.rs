@@ -75,16 +75,59 @@ impl Drop for Xvfb {
     }
 }
 
-/// `glint view` on `xvfb`, in `dir`.
-fn view_command(xvfb: &Xvfb, dir: &Path, args: &[&str]) -> Command {
-    let mut cmd = Command::new(GLINT);
-    cmd.arg("view")
-        .args(args)
-        .arg("--log-frames")
-        .current_dir(dir)
-        .env("DISPLAY", &xvfb.display)
-        .env_remove("WAYLAND_DISPLAY");
-    cmd
+/// What each windowed test starts with: an X server of its own and a temporary folder to run
+/// `glint view` in. None where the GPU tests are skipped.
+struct Session {
+    xvfb: Xvfb,
+    dir: tempfile::TempDir,
+}
+
+impl Session {
+    fn start() -> Option<Session> {
+        if skip_gpu() {
+            return None;
+        }
+        Some(Session {
+            xvfb: Xvfb::start(),
+            dir: tempfile::tempdir().unwrap(),
+        })
+    }
+
+    fn path(&self) -> &Path {
+        self.dir.path()
+    }
+
+    /// `glint view ARGS --log-frames` on this display, in this folder.
+    fn view(&self, args: &[&str]) -> Command {
+        let mut cmd = Command::new(GLINT);
+        cmd.arg("view")
+            .args(args)
+            .arg("--log-frames")
+            .current_dir(self.path())
+            .env("DISPLAY", &self.xvfb.display)
+            .env_remove("WAYLAND_DISPLAY");
+        cmd
+    }
+
+    /// `glint view` of the Cornell box at `width` × `height`, then `more`.
+    fn view_cornell(&self, width: u32, height: u32, more: &[&str]) -> Command {
+        let cornell = scene_path("cornell.toml");
+        let (width, height) = (width.to_string(), height.to_string());
+        let mut args = vec![
+            cornell.to_str().unwrap(),
+            "--width",
+            &width,
+            "--height",
+            &height,
+        ];
+        args.extend_from_slice(more);
+        self.view(&args)
+    }
+
+    /// Runs `cmd` to its end; its log, once it exited well.
+    fn log_of(cmd: &mut Command) -> Vec<Value> {
+        succeeded(&cmd.output().unwrap())
+    }
 }
 
 fn lines(stdout: &[u8]) -> Vec<Value> {
@@ -141,30 +184,14 @@ const BACK_WALL: ((f32, f32), (f32, f32)) = ((0.3, 0.7), (0.25, 0.5));
 
 #[test]
 fn cornell_screenshot_shows_the_green_and_red_walls() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
-    let out = view_command(
-        &x,
-        dir.path(),
-        &[
-            cornell.to_str().unwrap(),
-            "--width",
-            "96",
-            "--height",
-            "96",
-            "--frames",
-            "8",
-            "--screenshot",
-            "shot.png",
-        ],
-    )
-    .output()
-    .unwrap();
-    let log = succeeded(&out);
+    };
+    let log = Session::log_of(&mut session.view_cornell(
+        96,
+        96,
+        &["--frames", "8", "--screenshot", "shot.png"],
+    ));
     let frames = frames(&log);
     assert_eq!(frames.len(), 8);
     // The first frame is a 1-spp preview; then samples only accumulate.
@@ -182,7 +209,7 @@ fn cornell_screenshot_shows_the_green_and_red_walls() {
     assert_eq!(saved.len(), 1);
     assert_eq!(saved[0]["spp"], frames[7]["spp"]);
 
-    let png = image::open(dir.path().join("shot.png"))
+    let png = image::open(session.path().join("shot.png"))
         .unwrap()
         .into_rgb8();
     assert_eq!(png.dimensions(), (96, 96));
@@ -194,21 +221,13 @@ fn cornell_screenshot_shows_the_green_and_red_walls() {
 
 #[test]
 fn a_camera_move_restarts_the_accumulation_and_exposure_does_not() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
-    let out = view_command(
-        &x,
-        dir.path(),
+    };
+    let log = Session::log_of(&mut session.view_cornell(
+        48,
+        48,
         &[
-            cornell.to_str().unwrap(),
-            "--width",
-            "48",
-            "--height",
-            "48",
             "--spp-per-frame",
             "2",
             "--frames",
@@ -216,10 +235,7 @@ fn a_camera_move_restarts_the_accumulation_and_exposure_does_not() {
             "--script",
             "3:orbit 40 0; 5:exposure 1; 6:pan 5 5; 7:dolly 1; 8:fly 0 0 0.1; 9:restart; 10:save-png",
         ],
-    )
-    .output()
-    .unwrap();
-    let log = succeeded(&out);
+    ));
     let spp: Vec<u64> = frames(&log)
         .iter()
         .map(|f| f["spp"].as_u64().unwrap())
@@ -238,26 +254,18 @@ fn a_camera_move_restarts_the_accumulation_and_exposure_does_not() {
     assert_eq!(saved.len(), 1, "P saves once");
     let name = saved[0]["path"].as_str().unwrap();
     assert_eq!(name, "cornell-001.png");
-    assert!(dir.path().join(name).is_file());
+    assert!(session.path().join(name).is_file());
 }
 
 #[test]
 fn a_resize_restarts_at_the_new_size() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
-    let out = view_command(
-        &x,
-        dir.path(),
+    };
+    let log = Session::log_of(&mut session.view_cornell(
+        40,
+        40,
         &[
-            cornell.to_str().unwrap(),
-            "--width",
-            "40",
-            "--height",
-            "40",
             "--frames",
             "12",
             "--script",
@@ -265,10 +273,7 @@ fn a_resize_restarts_at_the_new_size() {
             "--screenshot",
             "shot.exr",
         ],
-    )
-    .output()
-    .unwrap();
-    let log = succeeded(&out);
+    ));
     let resized = events(&log, "resize");
     assert_eq!(resized.len(), 1, "{log:?}");
     let last = *frames(&log).last().unwrap();
@@ -278,7 +283,7 @@ fn a_resize_restarts_at_the_new_size() {
     );
     let first_big = frames(&log).into_iter().find(|f| f["width"] == 64).unwrap();
     assert_eq!(first_big["spp"], 1, "the new size starts from a preview");
-    let exr = glint::image::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
+    let exr = glint::image::output::Image::read_exr(&session.path().join("shot.exr")).unwrap();
     assert_eq!((exr.width, exr.height), (64, 32));
 }
 
@@ -358,35 +363,29 @@ fn good_then_broken_edit(
 
 #[test]
 fn scene_edits_on_disk_are_picked_up_and_broken_ones_keep_the_last_good_scene() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("box.toml");
+    };
+    let scene = session.path().join("box.toml");
     let original = std::fs::read_to_string(scene_path("cornell.toml")).unwrap();
     std::fs::write(&scene, &original).unwrap();
     // `wait-edit` holds the viewer at a frame until the file changes, so the edits land at
     // known frames; the change itself is found by the same polling as any edit.
-    let (child, rx) = spawn_with_log(view_command(
-        &x,
-        dir.path(),
-        &[
-            "box.toml",
-            "--width",
-            "48",
-            "--height",
-            "48",
-            "--spp-per-frame",
-            "4",
-            "--frames",
-            "14",
-            "--script",
-            "3:wait-edit; 8:wait-edit",
-            "--screenshot",
-            "shot.png",
-        ],
-    ));
+    let (child, rx) = spawn_with_log(session.view(&[
+        "box.toml",
+        "--width",
+        "48",
+        "--height",
+        "48",
+        "--spp-per-frame",
+        "4",
+        "--frames",
+        "14",
+        "--script",
+        "3:wait-edit; 8:wait-edit",
+        "--screenshot",
+        "shot.png",
+    ]));
     let waiting = |v: &Value| v["event"] == "waiting-for-edit";
     let mut log = wait_for(&rx, "first wait", waiting);
     // The red wall turns blue.
@@ -428,7 +427,7 @@ fn scene_edits_on_disk_are_picked_up_and_broken_ones_keep_the_last_good_scene() 
         .collect();
     // The good edit restarts; the broken one changes nothing.
     assert_eq!(spp, [1, 5, 9, 1, 5, 9, 13, 17, 21, 25, 29, 33, 37, 41]);
-    let png = image::open(dir.path().join("shot.png"))
+    let png = image::open(session.path().join("shot.png"))
         .unwrap()
         .into_rgb8();
     let right = mean_rgb(&png, RIGHT_WALL, WALL_ROWS);
@@ -494,26 +493,20 @@ fn bad_view_input_is_reported_before_any_window() {
 /// fails with a clear error and frames keep coming.
 #[test]
 fn a_scene_replaced_by_a_fifo_or_dev_zero_does_not_freeze_the_window() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("box.toml");
+    };
+    let scene = session.path().join("box.toml");
     std::fs::copy(scene_path("cornell.toml"), &scene).unwrap();
-    let (mut child, rx) = spawn_with_log(view_command(
-        &x,
-        dir.path(),
-        &[
-            "box.toml",
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--spp-per-frame",
-            "1",
-        ],
-    ));
+    let (mut child, rx) = spawn_with_log(session.view(&[
+        "box.toml",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--spp-per-frame",
+        "1",
+    ]));
     let is_frame = |v: &Value| v.get("frame").is_some() && v.get("event").is_none();
     wait_for(&rx, "a first frame", is_frame);
     type MakeSpecialFile<'a> = &'a dyn Fn(&Path);
@@ -528,7 +521,7 @@ fn a_scene_replaced_by_a_fifo_or_dev_zero_does_not_freeze_the_window() {
         }),
     ];
     for (needle, make) in replacements {
-        let tmp = dir.path().join("new.tmp");
+        let tmp = session.path().join("new.tmp");
         make(&tmp);
         std::fs::rename(&tmp, &scene).unwrap();
         let reload = wait_for(&rx, "the failed reload", |v| v["event"] == "reload");
@@ -582,19 +575,14 @@ fn roughness(png: &image::RgbImage, x: (f32, f32), y: (f32, f32)) -> f64 {
 
 #[test]
 fn d_denoises_the_shown_image_and_the_title_says_so() {
-    if skip_gpu() || !oidn_available() {
+    let Some(session) = Session::start() else {
+        return;
+    };
+    if !oidn_available() {
         return;
     }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
     let run = |script: &str, shot: &str| {
         let mut args = vec![
-            cornell.to_str().unwrap(),
-            "--width",
-            "48",
-            "--height",
-            "48",
             "--spp-per-frame",
             "2",
             "--frames",
@@ -605,8 +593,7 @@ fn d_denoises_the_shown_image_and_the_title_says_so() {
         if !script.is_empty() {
             args.extend(["--script", script]);
         }
-        let out = view_command(&x, dir.path(), &args).output().unwrap();
-        succeeded(&out)
+        Session::log_of(&mut session.view_cornell(48, 48, &args))
     };
     // D before the first frame; `wait-denoised` holds frame 3 until the background denoise
     // started at frame 1 (the first with 2 spp or more) lands.
@@ -648,7 +635,7 @@ fn d_denoises_the_shown_image_and_the_title_says_so() {
 
     // The screenshot is the denoised image of the same samples: smooth where the raw one is
     // noisy (19 spp), with the walls' colours kept.
-    let open = |name: &str| image::open(dir.path().join(name)).unwrap().into_rgb8();
+    let open = |name: &str| image::open(session.path().join(name)).unwrap().into_rgb8();
     let (denoised, raw) = (open("denoised.png"), open("raw.png"));
     for (cols, rows) in [(LEFT_WALL, WALL_ROWS), (RIGHT_WALL, WALL_ROWS), BACK_WALL] {
         let (rough_denoised, rough_raw) = (
@@ -672,33 +659,26 @@ fn d_denoises_the_shown_image_and_the_title_says_so() {
 
 #[test]
 fn d_without_oidn_keeps_the_raw_image_and_says_why_once() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
-    let out = view_command(
-        &x,
-        dir.path(),
-        &[
-            cornell.to_str().unwrap(),
-            "--width",
-            "32",
-            "--height",
-            "32",
-            "--spp-per-frame",
-            "1",
-            "--frames",
-            "6",
-            "--script",
-            "0:denoise; 2:denoise; 4:denoise",
-        ],
-    )
-    // An explicit library path that does not exist is the only place looked.
-    .env("GLINT_OIDN_LIB", "/nonexistent/libOpenImageDenoise.so")
-    .output()
-    .unwrap();
+    };
+    let out = session
+        .view_cornell(
+            32,
+            32,
+            &[
+                "--spp-per-frame",
+                "1",
+                "--frames",
+                "6",
+                "--script",
+                "0:denoise; 2:denoise; 4:denoise",
+            ],
+        )
+        // An explicit library path that does not exist is the only place looked.
+        .env("GLINT_OIDN_LIB", "/nonexistent/libOpenImageDenoise.so")
+        .output()
+        .unwrap();
     let log = succeeded(&out);
     let stderr = String::from_utf8_lossy(&out.stderr);
     let why: Vec<&str> = stderr
@@ -726,22 +706,14 @@ fn d_without_oidn_keeps_the_raw_image_and_says_why_once() {
 /// one stays linear. Same flags and frames, so both runs hold the same samples.
 #[test]
 fn tonemap_and_exposure_shape_png_screenshots_only() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
+    };
     for shot in ["shot.exr", "shot.png"] {
-        let out = view_command(
-            &x,
-            dir.path(),
+        Session::log_of(&mut session.view_cornell(
+            32,
+            32,
             &[
-                cornell.to_str().unwrap(),
-                "--width",
-                "32",
-                "--height",
-                "32",
                 "--spp-per-frame",
                 "2",
                 "--frames",
@@ -753,19 +725,16 @@ fn tonemap_and_exposure_shape_png_screenshots_only() {
                 "--screenshot",
                 shot,
             ],
-        )
-        .output()
-        .unwrap();
-        succeeded(&out);
+        ));
     }
-    let linear = glint::image::output::Image::read_exr(&dir.path().join("shot.exr")).unwrap();
+    let linear = glint::image::output::Image::read_exr(&session.path().join("shot.exr")).unwrap();
     let expected = glint::image::tonemap::DisplayTransform {
         tonemap: glint::image::tonemap::Tonemap::Agx,
         exposure: 1.5,
     }
     .image(&linear)
     .to_srgb8();
-    let png = image::open(dir.path().join("shot.png"))
+    let png = image::open(session.path().join("shot.png"))
         .unwrap()
         .into_rgb8();
     assert_eq!(png.into_raw(), expected);
@@ -815,27 +784,10 @@ fn resident_bytes(pid: u32) -> u64 {
 /// here. After start-up (the first 100 frames), the next 300 may add at most 16 MB.
 #[test]
 fn the_viewer_memory_stops_growing() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let cornell = scene_path("cornell.toml");
-    let cmd = view_command(
-        &x,
-        dir.path(),
-        &[
-            cornell.to_str().unwrap(),
-            "--width",
-            "64",
-            "--height",
-            "64",
-            "--spp-per-frame",
-            "1",
-            "--frames",
-            "420",
-        ],
-    );
+    };
+    let cmd = session.view_cornell(64, 64, &["--spp-per-frame", "1", "--frames", "420"]);
     let (mut child, rx) = spawn_with_log(cmd);
     let frame = |n: u64| move |l: &Value| l["frame"].as_u64() == Some(n);
     wait_for(&rx, "frame 100", frame(100));
@@ -853,36 +805,30 @@ fn the_viewer_memory_stops_growing() {
 
 #[test]
 fn a_model_file_is_viewed_and_its_edits_are_picked_up() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("lc.gltf");
+    };
+    let model = session.path().join("lc.gltf");
     let original = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models/lights-cameras.gltf"),
     )
     .unwrap();
     std::fs::write(&model, &original).unwrap();
-    let (child, rx) = spawn_with_log(view_command(
-        &x,
-        dir.path(),
-        &[
-            "lc.gltf",
-            "--camera",
-            "1",
-            "--width",
-            "32",
-            "--height",
-            "24",
-            "--spp-per-frame",
-            "2",
-            "--frames",
-            "10",
-            "--script",
-            "3:wait-edit; 6:wait-edit",
-        ],
-    ));
+    let (child, rx) = spawn_with_log(session.view(&[
+        "lc.gltf",
+        "--camera",
+        "1",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--spp-per-frame",
+        "2",
+        "--frames",
+        "10",
+        "--script",
+        "3:wait-edit; 6:wait-edit",
+    ]));
     // A dimmer point light, then a negative intensity.
     let bright = "\"intensity\": 6830";
     assert!(original.contains(bright));
@@ -902,41 +848,36 @@ fn a_model_file_is_viewed_and_its_edits_are_picked_up() {
 /// texture is picked up, and a broken one keeps the last good scene.
 #[test]
 fn edits_of_a_scenes_texture_are_picked_up() {
-    if skip_gpu() {
+    let Some(session) = Session::start() else {
         return;
-    }
-    let x = Xvfb::start();
-    let dir = tempfile::tempdir().unwrap();
+    };
+    let dir = session.path();
     std::fs::write(
-        dir.path().join("s.toml"),
+        dir.join("s.toml"),
         "[camera]\neye = [0, 0, -5]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nvfov = 40\n\
          [render]\nwidth = 16\nheight = 16\nspp = 1\nmax_bounces = 1\nbackground = [1, 1, 1]\n\
          [materials.m]\ntype = \"diffuse\"\ncolor = { texture = \"t.png\" }\n\
          [[spheres]]\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\n",
     )
     .unwrap();
-    let texture = dir.path().join("t.png");
+    let texture = dir.join("t.png");
     let save_png = |grey: u8| {
-        let tmp = dir.path().join("t.tmp.png");
+        let tmp = dir.join("t.tmp.png");
         image::GrayImage::from_pixel(2, 2, image::Luma([grey]))
             .save(&tmp)
             .unwrap();
         std::fs::rename(&tmp, &texture).unwrap();
     };
     save_png(100);
-    let (child, rx) = spawn_with_log(view_command(
-        &x,
-        dir.path(),
-        &[
-            "s.toml",
-            "--spp-per-frame",
-            "2",
-            "--frames",
-            "10",
-            "--script",
-            "3:wait-edit; 6:wait-edit",
-        ],
-    ));
+    let (child, rx) = spawn_with_log(session.view(&[
+        "s.toml",
+        "--spp-per-frame",
+        "2",
+        "--frames",
+        "10",
+        "--script",
+        "3:wait-edit; 6:wait-edit",
+    ]));
     let (error, spp) = good_then_broken_edit(
         (child, rx),
         || save_png(200),
