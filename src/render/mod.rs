@@ -200,7 +200,7 @@ pub fn render_progressive(
             break;
         }
         // Batches end only where the merge schedule's blocks do, so the image's bytes do not
-        // depend on the batch sizes, which follow the wall clock (src/cpu/integrator/accumulate.rs). The
+        // depend on the batch sizes, which follow the wall clock (src/kernel/schedule.rs). The
         // blocks are of global sample indices, so a partial render's batches end where a
         // single render's would.
         let first = renderer.first_sample();
