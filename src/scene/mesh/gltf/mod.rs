@@ -13,9 +13,10 @@
 //! bounds set by the file's real size. Each error names the element (`accessors[3]`).
 //!
 //! In this folder, in the order a file is read: `document.rs` (the JSON and buffers),
-//! `extensions.rs`, `nodes.rs` (the hierarchy), `material.rs`, `primitives.rs` and
-//! `accessor.rs` (the vertex data), `instancing.rs` (EXT_mesh_gpu_instancing), and the
-//! cameras and punctual lights (`cameras.rs`, `lights.rs`) that hang from the nodes.
+//! `extensions.rs`, `nodes.rs` (the hierarchy), `material.rs` and `texture_ref.rs` (its
+//! texture references), `primitives.rs` and `accessor.rs` (the vertex data), `instancing.rs`
+//! (EXT_mesh_gpu_instancing), and the cameras and punctual lights (`cameras.rs`, `lights.rs`)
+//! that hang from the nodes.
 
 mod accessor;
 pub(super) mod cameras;
@@ -26,6 +27,7 @@ pub(super) mod lights;
 mod material;
 mod nodes;
 mod primitives;
+mod texture_ref;
 
 pub use extensions::{ExtensionSupport, GLTF_EXTENSIONS};
 
