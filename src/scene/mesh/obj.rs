@@ -8,7 +8,7 @@ use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
 use crate::scene::{Alpha, AlphaMode, Material, MaterialKind};
 use glam::{Vec2, Vec3};
 use std::io::{BufRead, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 /// A reader that counts the lines consumed, so an OBJ error can name the line tobj stopped at
@@ -72,101 +72,24 @@ fn obj_material(
     dir: &Path,
 ) -> Result<(Material, FileTextures, bool, Vec<String>), String> {
     let name = &m.name;
-    let mut warnings = Vec::new();
-    let param = |key: &str| m.unknown_param.get(key).map(|v| v.trim());
-    let number = |key: &str| {
-        param(key)
-            .map(|v| {
-                v.parse::<f32>()
-                    .ok()
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| format!("material {name:?}: {key}: not a number: {v:?}"))
-            })
-            .transpose()
-    };
-    let unit = |key: &str, v: f32| {
-        if (0.0..=1.0).contains(&v) {
-            Ok(v)
-        } else {
-            Err(format!(
-                "material {name:?}: {key} must be in [0, 1], got {v}"
-            ))
-        }
-    };
-    let map = |value: Option<&str>, key: &str| {
-        value
-            .map(|v| {
-                map_statement(v)
-                    .map(|(file, scale)| (dir.join(file), scale))
-                    .ok_or_else(|| format!("material {name:?}: {key}: no image file named"))
-            })
-            .transpose()
-    };
+    let mtl = MtlStatements { m, dir };
     let kd = Vec3::from(m.diffuse.unwrap_or([0.8; 3]));
-    let map_ke = map(param("map_Ke"), "map_Ke")?;
+    let map_ke = mtl.map(mtl.param("map_Ke"), "map_Ke")?;
     let ke = m.emissive.map(Vec3::from).unwrap_or(if map_ke.is_some() {
         Vec3::ONE
     } else {
         Vec3::ZERO
     });
     let emission = check_emission(name, "Ke", ke)?;
-    // `d` (dissolve) is the opacity; `Tr` (transparency), which some exporters write in its
-    // place, is 1 − d. Blender writes `d 1.000000` on every opaque material: only d < 1 makes
-    // a material blended, so those stay opaque, at no alpha cost.
-    let opacity = match (m.dissolve, number("Tr")?) {
-        (Some(d), _) => unit("d", d)?,
-        (None, Some(tr)) => 1.0 - unit("Tr", tr)?,
-        (None, None) => 1.0,
-    };
-    let is_pbr = PBR_STATEMENTS.iter().any(|k| param(k).is_some());
-    // Checked whatever the material's kind, as a scene file's `ior` is. Exporters write `Ni 0`
-    // (Blender for some materials, 3ds Max) where they mean no index: that is the default.
-    let ior = match m.optical_density {
-        None | Some(0.0) => 1.5,
-        Some(n) => check_ior(name, "Ni", n)?,
-    };
-    let kind = if is_pbr {
-        let roughness = match number("Pr")? {
-            Some(r) => unit("Pr", r)?,
-            None => m
-                .shininess
-                .map_or(0.5, |ns| 1.0 - (ns.clamp(0.0, 1000.0) / 1000.0).sqrt()),
-        };
-        MaterialKind::Pbr {
-            roughness,
-            metallic: unit("Pm", number("Pm")?.unwrap_or(0.0))?,
-            ior,
-            specular: 1.0,
-            specular_color: Vec3::ONE,
-            transmission: 0.0,
-            transmission_texture: None,
-            attenuation_color: Vec3::ONE,
-            attenuation_distance: None,
-            layers: Default::default(),
-        }
-    } else if matches!(m.illumination_model, Some(3) | Some(5)) {
-        MaterialKind::Specular
-    } else {
-        MaterialKind::Diffuse
-    };
-    let unread: Vec<&str> = UNREAD_PBR_STATEMENTS
-        .iter()
-        .copied()
-        .filter(|k| param(k).is_some())
-        .collect();
-    if !unread.is_empty() {
-        warnings.push(format!(
-            "material {name:?}: {} (sheen, clearcoat, anisotropy) not read; ignored",
-            unread.join(", ")
-        ));
-    }
+    let opacity = mtl.opacity()?;
+    let kind = mtl.kind()?;
+    let warnings = mtl.unread_pbr_warning().into_iter().collect();
     let color = match kind {
         MaterialKind::Specular => {
             check_reflectance(name, "Ks", Vec3::from(m.specular.unwrap_or(kd.to_array())))?
         }
         _ => check_reflectance(name, "Kd", kd)?,
     };
-    let mut maps = FileTextures::default();
     let mut material = Material {
         name: name.clone(),
         kind,
@@ -185,62 +108,224 @@ fn obj_material(
             Alpha::OPAQUE
         },
     };
-    let mut other_textures = false;
-    // map_Kd is the diffuse or base colour: mirrors (Ks) do not use it.
-    if let Some((file, _)) = map(m.diffuse_texture.as_deref(), "map_Kd")? {
-        if matches!(kind, MaterialKind::Diffuse | MaterialKind::Pbr { .. }) {
-            // map_Kd replaces Kd (the kernel multiplies the colour by the texture).
-            material.color = Vec3::ONE;
-            maps.color = Some((Rc::new(ImageSource::File(file)), Default::default()));
+    let (maps, other_textures) = mtl.texture_maps(&mut material, map_ke)?;
+    let other_textures = other_textures | mtl.has_unread_textures();
+    Ok((material, maps, other_textures, warnings))
+}
+
+/// A map statement's image file (relative to the OBJ's folder) and its `-bm`.
+type MapFile = (PathBuf, Option<f32>);
+
+/// One `.mtl` material's statements, read and checked; errors name the material.
+struct MtlStatements<'a> {
+    m: &'a tobj::Material,
+    /// The folder the map statements' files are relative to.
+    dir: &'a Path,
+}
+
+impl<'a> MtlStatements<'a> {
+    /// Statement `key`'s value, trimmed, among those tobj does not read itself.
+    fn param(&self, key: &str) -> Option<&'a str> {
+        self.m.unknown_param.get(key).map(|v| v.trim())
+    }
+
+    /// Statement `key`'s value as a finite number.
+    fn number(&self, key: &str) -> Result<Option<f32>, String> {
+        let name = &self.m.name;
+        self.param(key)
+            .map(|v| {
+                v.parse::<f32>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| format!("material {name:?}: {key}: not a number: {v:?}"))
+            })
+            .transpose()
+    }
+
+    /// `v`, statement `key`'s, checked to lie in [0, 1].
+    fn unit(&self, key: &str, v: f32) -> Result<f32, String> {
+        let name = &self.m.name;
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
         } else {
-            other_textures = true;
+            Err(format!(
+                "material {name:?}: {key} must be in [0, 1], got {v}"
+            ))
         }
     }
-    // map_d's first channel is the opacity: it becomes the colour texture's alpha, merged on
-    // load with map_Kd where the material reads that (white otherwise, so the colour is the
-    // constant's).
-    if let Some((file, _)) = map(m.dissolve_texture.as_deref(), "map_d")? {
-        let color = maps
-            .color
-            .take()
-            .and(map(m.diffuse_texture.as_deref(), "map_Kd")?)
-            .map(|(f, _)| f);
-        maps.color_and_opacity = Some((color, file));
-        material.alpha.mode = AlphaMode::Blend;
+
+    /// Map statement `key` of value `value` (`None`: not given): its file and `-bm`.
+    fn map(&self, value: Option<&str>, key: &str) -> Result<Option<MapFile>, String> {
+        let name = &self.m.name;
+        value
+            .map(|v| {
+                map_statement(v)
+                    .map(|(file, scale)| (self.dir.join(file), scale))
+                    .ok_or_else(|| format!("material {name:?}: {key}: no image file named"))
+            })
+            .transpose()
     }
-    let map_pr = map(param("map_Pr"), "map_Pr")?.map(|(f, _)| f);
-    let map_pm = map(param("map_Pm"), "map_Pm")?.map(|(f, _)| f);
-    if map_pr.is_some() || map_pm.is_some() {
-        maps.roughness_and_metallic = Some((map_pr, map_pm));
+
+    /// The opacity, checked to lie in [0, 1].
+    fn opacity(&self) -> Result<f32, String> {
+        // `d` (dissolve) is the opacity; `Tr` (transparency), which some exporters write in its
+        // place, is 1 − d. Blender writes `d 1.000000` on every opaque material: only d < 1
+        // makes a material blended, so those stay opaque, at no alpha cost.
+        Ok(match (self.m.dissolve, self.number("Tr")?) {
+            (Some(d), _) => self.unit("d", d)?,
+            (None, Some(tr)) => 1.0 - self.unit("Tr", tr)?,
+            (None, None) => 1.0,
+        })
     }
-    if let Some((file, _)) = map_ke {
-        maps.emission = Some((Rc::new(ImageSource::File(file)), Default::default()));
+
+    /// `pbr` where a PBR-extension statement is given, else a mirror under illum 3 or 5, else
+    /// diffuse; the ior `Ni` is checked whatever the kind.
+    fn kind(&self) -> Result<MaterialKind, String> {
+        let m = self.m;
+        let is_pbr = PBR_STATEMENTS.iter().any(|k| self.param(k).is_some());
+        // Checked whatever the material's kind, as a scene file's `ior` is. Exporters write
+        // `Ni 0` (Blender for some materials, 3ds Max) where they mean no index: that is the
+        // default.
+        let ior = match m.optical_density {
+            None | Some(0.0) => 1.5,
+            Some(n) => check_ior(&m.name, "Ni", n)?,
+        };
+        Ok(if is_pbr {
+            self.pbr_kind(ior)?
+        } else if matches!(m.illumination_model, Some(3) | Some(5)) {
+            MaterialKind::Specular
+        } else {
+            MaterialKind::Diffuse
+        })
     }
-    // tobj files `map_Bump` and `bump` as its normal texture; `norm` is the PBR extension's.
-    let (normal_key, normal) = match param("norm") {
-        Some(v) => ("norm", Some(v)),
-        None => ("map_Bump", m.normal_texture.as_deref()),
-    };
-    if let Some((file, scale)) = map(normal, normal_key)? {
-        let scale = check_normal_scale(name, &format!("{normal_key}'s -bm"), scale.unwrap_or(1.0))?;
-        maps.normal = Some((
-            (Rc::new(ImageSource::File(file)), Default::default()),
-            scale,
-        ));
+
+    /// The `pbr` kind: roughness `Pr` (else from `Ns`), metallic `Pm`, ior `ior`.
+    fn pbr_kind(&self, ior: f32) -> Result<MaterialKind, String> {
+        let roughness = match self.number("Pr")? {
+            Some(r) => self.unit("Pr", r)?,
+            None => self
+                .m
+                .shininess
+                .map_or(0.5, |ns| 1.0 - (ns.clamp(0.0, 1000.0) / 1000.0).sqrt()),
+        };
+        Ok(MaterialKind::Pbr {
+            roughness,
+            metallic: self.unit("Pm", self.number("Pm")?.unwrap_or(0.0))?,
+            ior,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+            transmission: 0.0,
+            transmission_texture: None,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: None,
+            layers: Default::default(),
+        })
     }
-    other_textures |= [
-        &m.ambient_texture,
-        &m.specular_texture,
-        &m.shininess_texture,
-    ]
-    .iter()
-    .any(|t| t.is_some())
-        || m.unknown_param.keys().any(|k| {
-            (k.starts_with("map_") || k == "disp" || k == "refl")
-                && !matches!(k.as_str(), "map_Pr" | "map_Pm" | "map_Ke")
-                && !UNREAD_PBR_STATEMENTS.contains(&k.as_str())
-        });
-    Ok((material, maps, other_textures, warnings))
+
+    /// The warning for the PBR-extension statements given that glint does not read.
+    fn unread_pbr_warning(&self) -> Option<String> {
+        let unread: Vec<&str> = UNREAD_PBR_STATEMENTS
+            .iter()
+            .copied()
+            .filter(|k| self.param(k).is_some())
+            .collect();
+        (!unread.is_empty()).then(|| {
+            format!(
+                "material {:?}: {} (sheen, clearcoat, anisotropy) not read; ignored",
+                self.m.name,
+                unread.join(", ")
+            )
+        })
+    }
+
+    /// The texture maps, and whether a map glint does not read is given (map_Kd on a mirror);
+    /// map_Kd makes `material`'s colour white, map_d its alpha blended. `map_ke` is map_Ke's,
+    /// read with the emission.
+    fn texture_maps(
+        &self,
+        material: &mut Material,
+        map_ke: Option<MapFile>,
+    ) -> Result<(FileTextures, bool), String> {
+        let m = self.m;
+        let mut maps = FileTextures::default();
+        let mut other_textures = false;
+        // map_Kd is the diffuse or base colour: mirrors (Ks) do not use it.
+        if let Some((file, _)) = self.map(m.diffuse_texture.as_deref(), "map_Kd")? {
+            if matches!(
+                material.kind,
+                MaterialKind::Diffuse | MaterialKind::Pbr { .. }
+            ) {
+                // map_Kd replaces Kd (the kernel multiplies the colour by the texture).
+                material.color = Vec3::ONE;
+                maps.color = Some((Rc::new(ImageSource::File(file)), Default::default()));
+            } else {
+                other_textures = true;
+            }
+        }
+        // map_d's first channel is the opacity: it becomes the colour texture's alpha, merged
+        // on load with map_Kd where the material reads that (white otherwise, so the colour is
+        // the constant's).
+        if let Some((file, _)) = self.map(m.dissolve_texture.as_deref(), "map_d")? {
+            let color = maps
+                .color
+                .take()
+                .and(self.map(m.diffuse_texture.as_deref(), "map_Kd")?)
+                .map(|(f, _)| f);
+            maps.color_and_opacity = Some((color, file));
+            material.alpha.mode = AlphaMode::Blend;
+        }
+        let map_pr = self.map(self.param("map_Pr"), "map_Pr")?.map(|(f, _)| f);
+        let map_pm = self.map(self.param("map_Pm"), "map_Pm")?.map(|(f, _)| f);
+        if map_pr.is_some() || map_pm.is_some() {
+            maps.roughness_and_metallic = Some((map_pr, map_pm));
+        }
+        if let Some((file, _)) = map_ke {
+            maps.emission = Some((Rc::new(ImageSource::File(file)), Default::default()));
+        }
+        if let Some((file, scale)) = self.normal_map()? {
+            maps.normal = Some((
+                (Rc::new(ImageSource::File(file)), Default::default()),
+                scale,
+            ));
+        }
+        Ok((maps, other_textures))
+    }
+
+    /// The normal map (`norm`, `map_Bump` or `bump`): its file and scale (`-bm`, checked).
+    fn normal_map(&self) -> Result<Option<(PathBuf, f32)>, String> {
+        // tobj files `map_Bump` and `bump` as its normal texture; `norm` is the PBR extension's.
+        let (normal_key, normal) = match self.param("norm") {
+            Some(v) => ("norm", Some(v)),
+            None => ("map_Bump", self.m.normal_texture.as_deref()),
+        };
+        let Some((file, scale)) = self.map(normal, normal_key)? else {
+            return Ok(None);
+        };
+        let scale = check_normal_scale(
+            &self.m.name,
+            &format!("{normal_key}'s -bm"),
+            scale.unwrap_or(1.0),
+        )?;
+        Ok(Some((file, scale)))
+    }
+
+    /// Whether a map statement glint does not read is given (map_Ka, map_Ks, map_Ns, disp,
+    /// refl, ...; the unread PBR ones have their own warning).
+    fn has_unread_textures(&self) -> bool {
+        let m = self.m;
+        [
+            &m.ambient_texture,
+            &m.specular_texture,
+            &m.shininess_texture,
+        ]
+        .iter()
+        .any(|t| t.is_some())
+            || m.unknown_param.keys().any(|k| {
+                (k.starts_with("map_") || k == "disp" || k == "refl")
+                    && !matches!(k.as_str(), "map_Pr" | "map_Pm" | "map_Ke")
+                    && !UNREAD_PBR_STATEMENTS.contains(&k.as_str())
+            })
+    }
 }
 
 /// The image file of an `.mtl` map statement's value and its `-bm` (bump multiplier): the
