@@ -7,7 +7,8 @@ struct Params {
     // Unit vector from the eye towards the target.
     forward: vec3<f32>,
     height: u32,
-    // Image-right and image-up, scaled to half the viewport at unit distance.
+    // Image-right and image-up, scaled to half the viewport at unit distance (perspective) or
+    // to half the view's width and height in world units (orthographic).
     right: vec3<f32>,
     // The global index of this batch's first sample (the random streams depend on it).
     sample_start: u32,
@@ -47,7 +48,14 @@ struct Params {
     // Probability that light sampling picks the environment map (0 when it is not sampled).
     environment_light_probability: f32,
     light_count: u32,
+    // PROJECTION_PERSPECTIVE or PROJECTION_ORTHOGRAPHIC (camera.wgsl).
+    projection: u32,
 }
+
+// Params.projection: camera rays from the eye (or the lens) through the image plane, or
+// parallel ones along `forward` from the image plane through the eye.
+const PROJECTION_PERSPECTIVE: u32 = 0u;
+const PROJECTION_ORTHOGRAPHIC: u32 = 1u;
 
 struct Sphere {
     center: vec3<f32>,

@@ -12,7 +12,8 @@ pub struct Params {
     /// Unit vector from the eye towards the target.
     pub forward: [f32; 3],
     pub height: u32,
-    /// Image-right and image-up, scaled to half the viewport at unit distance.
+    /// Image-right and image-up, scaled to half the viewport at unit distance (perspective) or
+    /// to half the view's width and height in world units (orthographic).
     pub right: [f32; 3],
     pub sample_start: u32,
     pub up: [f32; 3],
@@ -52,10 +53,19 @@ pub struct Params {
     pub environment_light_probability: f32,
     /// Point, spot and directional lights (`lights`).
     pub light_count: u32,
+    /// `PROJECTION_PERSPECTIVE` or `PROJECTION_ORTHOGRAPHIC` (`src/cpu/core/camera.rs`).
+    pub projection: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.
 pub const ROULETTE_OFF: u32 = u32::MAX;
+
+/// `Params::projection`: camera rays from the eye (or the lens) through the image plane.
+pub const PROJECTION_PERSPECTIVE: u32 = 0;
+/// `Params::projection`: parallel camera rays along `forward`, from the image plane through
+/// the eye.
+pub const PROJECTION_ORTHOGRAPHIC: u32 = 1;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

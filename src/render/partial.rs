@@ -5,6 +5,7 @@
 //! every setting that changes the image. Every EXR `glint render` writes is one, so any EXR
 //! render, interrupted or not, can be resumed or merged.
 
+use crate::kernel::types::{Params, PROJECTION_PERSPECTIVE};
 use crate::kernel::KernelScene;
 use crate::render::accumulation::Accumulation;
 use crate::scene::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
@@ -99,7 +100,16 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         hasher.update(format!("{name} {}\n", bytes.len()));
         hasher.update(bytes);
     };
-    array("params", bytemuck::bytes_of(&params));
+    // A perspective camera's parameters hash as they did before `projection` (and its padding)
+    // joined them, so the settings, and the headers of files rendered with them, stay what they
+    // were; an orthographic camera's hash them all, `projection` = 1 included.
+    let params_bytes = bytemuck::bytes_of(&params);
+    let params_bytes = if params.projection == PROJECTION_PERSPECTIVE {
+        &params_bytes[..std::mem::offset_of!(Params, projection)]
+    } else {
+        params_bytes
+    };
+    array("params", params_bytes);
     array("spheres", bytemuck::cast_slice(spheres));
     array("quads", bytemuck::cast_slice(quads));
     array("materials", bytemuck::cast_slice(materials));

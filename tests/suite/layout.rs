@@ -116,7 +116,8 @@ fn rust_structs_match_wgsl_layout() {
             environment_cos,
             environment_sin,
             environment_light_probability,
-            light_count
+            light_count,
+            projection
         ]
     );
     assert_same_layout!(
@@ -283,8 +284,8 @@ fn rust_structs_match_wgsl_layout() {
     );
 }
 
-/// The kernel's constants that mirror the host's: material kinds, alpha modes, and the sizes
-/// and offsets of the energy tables it indexes.
+/// The kernel's constants that mirror the host's: material kinds, alpha modes, projections,
+/// and the sizes and offsets of the energy tables it indexes.
 #[test]
 fn wgsl_constants_match_the_hosts() {
     let module = parse_and_validate();
@@ -312,6 +313,8 @@ fn wgsl_constants_match_the_hosts() {
         ("ALPHA_OPAQUE", t::ALPHA_OPAQUE),
         ("ALPHA_MASK", t::ALPHA_MASK),
         ("ALPHA_BLEND", t::ALPHA_BLEND),
+        ("PROJECTION_PERSPECTIVE", t::PROJECTION_PERSPECTIVE),
+        ("PROJECTION_ORTHOGRAPHIC", t::PROJECTION_ORTHOGRAPHIC),
         ("WIDE_EMPTY_CHILD", t::WIDE_EMPTY_CHILD),
         ("GGX_ENERGY_SIZE", g::GGX_ENERGY_SIZE as u32),
         ("GGX_ENERGY_OFFSET_A", g::OFFSET_A as u32),

@@ -1,8 +1,9 @@
-//! Thin-lens camera (WGSL side: `shaders/core/camera.wgsl`); a pinhole when the lens radius is 0.
+//! Thin-lens camera (WGSL side: `shaders/core/camera.wgsl`); a pinhole when the lens radius is
+//! 0, or an orthographic camera (`Params::projection`).
 
 use crate::cpu::core::frame::PI;
 use crate::cpu::core::ray::Ray;
-use crate::kernel::types::Params;
+use crate::kernel::types::{Params, PROJECTION_ORTHOGRAPHIC};
 use glam::{Vec2, Vec3};
 
 /// Uniform point in the unit disk (polar mapping; r = √u makes it uniform in area).
@@ -15,6 +16,17 @@ pub fn sample_unit_disk(u: (f32, f32)) -> Vec2 {
 pub fn camera_ray(params: &Params, px: u32, py: u32, jitter: (f32, f32), lens: (f32, f32)) -> Ray {
     let ndc_x = (px as f32 + jitter.0) / params.width as f32 * 2.0 - 1.0;
     let ndc_y = 1.0 - (py as f32 + jitter.1) / params.height as f32 * 2.0;
+    if params.projection == PROJECTION_ORTHOGRAPHIC {
+        // The jittered point on the image plane (through the eye, across the view; `right` and
+        // `up` span half the view in world units), looking along the view direction. No lens:
+        // `lens` goes unused.
+        return Ray {
+            origin: Vec3::from(params.eye)
+                + ndc_x * Vec3::from(params.right)
+                + ndc_y * Vec3::from(params.up),
+            dir: Vec3::from(params.forward),
+        };
+    }
     // `forward` is unit length, so this point lies on the focus plane.
     let through = Vec3::from(params.forward)
         + ndc_x * Vec3::from(params.right)
