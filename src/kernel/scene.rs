@@ -129,16 +129,25 @@ impl KernelScene {
 }
 
 /// Writes `camera` into `params` for its image size (`params.width`, `params.height`): the
-/// basis precomputed, image-right and image-up scaled to half the viewport at unit distance,
-/// and the lens. Apart from the rest so the viewer can move the camera without rebuilding the
-/// scene's arrays (the BVH, the environment map's tables).
+/// basis precomputed, image-right and image-up scaled to half the viewport at unit distance
+/// (perspective) or to half the view in world units (orthographic), and the lens. Apart from
+/// the rest so the viewer can move the camera without rebuilding the scene's arrays (the BVH,
+/// the environment map's tables).
 pub fn place_camera(params: &mut Params, camera: &Camera) {
+    use crate::scene::Projection;
     let CameraBasis {
         w,
         right: u,
         image_up: v,
     } = camera.basis();
-    let half_height = (camera.vfov.to_radians() * 0.5).tan();
+    let (projection, half_height) = match camera.projection {
+        Projection::Perspective { vfov } => (
+            types::PROJECTION_PERSPECTIVE,
+            (vfov.to_radians() * 0.5).tan(),
+        ),
+        Projection::Orthographic { height } => (types::PROJECTION_ORTHOGRAPHIC, 0.5 * height),
+    };
+    params.projection = projection;
     let half_width = half_height * params.width as f32 / params.height as f32;
     let lens_radius = 0.5 * camera.aperture;
     params.eye = camera.eye.into();

@@ -70,11 +70,16 @@ pub(super) struct SceneToml {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct CameraToml {
-    /// `eye`, `target`, `up` and `vfov`, or `from` (with `index`).
+    /// `eye`, `target`, `up` and `vfov` (or `projection = "orthographic"` and `height`), or
+    /// `from` (with `index`).
     pub(super) eye: Option<S<Triple>>,
     pub(super) target: Option<S<Triple>>,
     pub(super) up: Option<S<Triple>>,
     pub(super) vfov: Option<S<Real>>,
+    /// `"perspective"` (the default) or `"orthographic"`.
+    pub(super) projection: Option<S<String>>,
+    /// An orthographic camera's view height, in world units.
+    pub(super) height: Option<S<Real>>,
     /// A glTF file (relative to the scene file's folder) whose camera this is.
     pub(super) from: Option<S<String>>,
     /// Which of its cameras (in node order); without it, the first perspective one.

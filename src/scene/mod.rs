@@ -148,12 +148,23 @@ pub struct Camera {
     pub eye: Vec3,
     pub target: Vec3,
     pub up: Vec3,
-    /// Vertical field of view in degrees, in (0, 180).
-    pub vfov: f32,
-    /// Lens diameter; 0 is a pinhole.
+    pub projection: Projection,
+    /// Lens diameter; 0 is a pinhole (always for an orthographic camera).
     pub aperture: f32,
     /// Distance to the plane in focus, along the view direction.
     pub focus_distance: f32,
+}
+
+/// How the camera projects the scene onto the image (`[camera] projection`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Rays through the eye (or the lens): `vfov` is the vertical field of view in degrees, in
+    /// (0, 180).
+    Perspective { vfov: f32 },
+    /// Parallel rays along the view direction, starting on the image plane (through the eye,
+    /// across the view): `height` is the view's height in world units (> 0); its width follows
+    /// the image's aspect ratio.
+    Orthographic { height: f32 },
 }
 
 /// The camera's orthonormal basis, right-handed: `w` points from the target back at the eye,

@@ -12,7 +12,8 @@ use super::limits::MAX_COORDINATE;
 use super::mesh::{self, MeshTransform, NO_MATERIAL};
 use super::texture::TextureSet;
 use super::{
-    check_image_size, studio, Camera, Material, MaterialKind, RenderSettings, Scene, SceneError,
+    check_image_size, studio, Camera, Material, MaterialKind, Projection, RenderSettings, Scene,
+    SceneError,
 };
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
@@ -177,7 +178,12 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
     let (width, height) = image_size(options.width, options.height, aspect);
     check_image_size(width as i64, height as i64).map_err(error)?;
     let camera = match &file_camera {
-        Some(c) => pinhole(c.eye, c.target(), c.up, c.vfov),
+        Some(c) => pinhole(
+            c.eye,
+            c.target(),
+            c.up,
+            Projection::Perspective { vfov: c.vfov },
+        ),
         None => framing_camera(centre, radius, width as f64 / height as f64).map_err(error)?,
     };
 
@@ -294,13 +300,14 @@ pub fn image_size(width: Option<u32>, height: Option<u32>, aspect: Option<f32>) 
     }
 }
 
-/// A pinhole camera, its focus distance computed as a scene file's is.
-pub fn pinhole(eye: Vec3, target: Vec3, up: Vec3, vfov: f32) -> Camera {
+/// A camera without a lens (a pinhole, or an orthographic camera), its focus distance computed
+/// as a scene file's is.
+pub fn pinhole(eye: Vec3, target: Vec3, up: Vec3, projection: Projection) -> Camera {
     Camera {
         eye,
         target,
         up,
-        vfov,
+        projection,
         aperture: 0.0,
         focus_distance: (target - eye).as_dvec3().length() as f32,
     }
@@ -342,7 +349,7 @@ pub fn framing_camera(centre: DVec3, radius: f64, aspect: f64) -> Result<Camera,
         eye.as_vec3(),
         centre.as_vec3(),
         Vec3::Y,
-        FRAMING_VFOV,
+        Projection::Perspective { vfov: FRAMING_VFOV },
     ))
 }
 

@@ -7,6 +7,7 @@
 use super::light::{Light, LightKind};
 use super::model::{EnvironmentSource, ModelScene, DEFAULT_COLOR, DEFAULT_MATERIAL};
 use super::studio;
+use super::Projection;
 use glam::Vec3;
 use std::fmt::Write;
 
@@ -37,7 +38,15 @@ pub fn model_toml(model: &ModelScene) -> String {
     let _ = writeln!(out, "eye = {}", triple(c.eye));
     let _ = writeln!(out, "target = {}", triple(c.target));
     let _ = writeln!(out, "up = {}", triple(c.up));
-    let _ = writeln!(out, "vfov = {}", real(c.vfov));
+    match c.projection {
+        Projection::Perspective { vfov } => {
+            let _ = writeln!(out, "vfov = {}", real(vfov));
+        }
+        Projection::Orthographic { height } => {
+            let _ = writeln!(out, "projection = \"orthographic\"");
+            let _ = writeln!(out, "height = {}", real(height));
+        }
+    }
     if c.aperture > 0.0 {
         let _ = writeln!(out, "aperture = {}", real(c.aperture));
         let _ = writeln!(out, "focus_distance = {}", real(c.focus_distance));

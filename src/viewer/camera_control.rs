@@ -4,8 +4,14 @@
 //! Screen deltas are in window pixels, x to the right and y down, as winit reports the cursor.
 //! Every move keeps `up` as the scene gave it; orbiting stops short of the poles so the view
 //! direction never becomes parallel to `up` (the camera basis would be undefined there).
+//!
+//! An orthographic camera orbits, pans and flies as a perspective one does (it pans by its
+//! view's height per window height); its dolly zooms instead, scaling the view's height by
+//! the same factor per step and leaving the eye where it is: moving an orthographic camera
+//! along its view changes nothing in the image but where the image plane cuts the scene.
 
-use crate::scene::Camera;
+use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH};
+use crate::scene::{Camera, Projection};
 use glam::Quat;
 
 /// Orbit angle per pixel of drag, in radians: a drag across a 512-pixel window turns ~147°.
@@ -40,12 +46,16 @@ pub fn orbit(cam: &Camera, dx: f32, dy: f32) -> Camera {
     Camera { eye, ..cam.clone() }
 }
 
-/// Slides eye and target in the image plane so the point at the target's depth follows the
-/// cursor; `viewport_height` is the window height in pixels.
+/// Slides eye and target in the image plane so the point at the target's depth (any point,
+/// for an orthographic camera) follows the cursor; `viewport_height` is the window height in
+/// pixels.
 pub fn pan(cam: &Camera, dx: f32, dy: f32, viewport_height: u32) -> Camera {
     let b = cam.basis();
-    let world_per_pixel =
-        2.0 * distance(cam) * (cam.vfov.to_radians() * 0.5).tan() / viewport_height.max(1) as f32;
+    let visible_height = match cam.projection {
+        Projection::Perspective { vfov } => 2.0 * distance(cam) * (vfov.to_radians() * 0.5).tan(),
+        Projection::Orthographic { height } => height,
+    };
+    let world_per_pixel = visible_height / viewport_height.max(1) as f32;
     let delta = (-dx * b.right + dy * b.image_up) * world_per_pixel;
     Camera {
         eye: cam.eye + delta,
@@ -55,8 +65,16 @@ pub fn pan(cam: &Camera, dx: f32, dy: f32, viewport_height: u32) -> Camera {
 }
 
 /// Moves the eye towards the target (`steps` > 0, wheel up) or away from it; it never reaches
-/// or passes the target.
+/// or passes the target. An orthographic camera zooms instead: its view's height shrinks (or
+/// grows) by the same factor, within the lengths a scene file takes.
 pub fn dolly(cam: &Camera, steps: f32) -> Camera {
+    if let Projection::Orthographic { height } = cam.projection {
+        let height = (height * DOLLY_FACTOR_PER_STEP.powf(steps)).clamp(MIN_LENGTH, MAX_COORDINATE);
+        return Camera {
+            projection: Projection::Orthographic { height },
+            ..cam.clone()
+        };
+    }
     let b = cam.basis();
     let dist = (distance(cam) * DOLLY_FACTOR_PER_STEP.powf(steps)).max(MIN_DISTANCE);
     Camera {
@@ -87,7 +105,7 @@ mod tests {
             eye: Vec3::new(278.0, 278.0, -800.0),
             target: Vec3::new(278.0, 278.0, 0.0),
             up: Vec3::Y,
-            vfov: 40.0,
+            projection: Projection::Perspective { vfov: 40.0 },
             aperture: 0.0,
             focus_distance: 800.0,
         }
@@ -165,6 +183,39 @@ mod tests {
         let very_close = dolly(&c, 1e4);
         assert!(distance(&very_close) > 0.0);
         assert!(very_close.basis().w.dot(c.basis().w) > 0.999);
+    }
+
+    fn orthographic(height: f32) -> Camera {
+        Camera {
+            projection: Projection::Orthographic { height },
+            ..cornell()
+        }
+    }
+
+    #[test]
+    fn an_orthographic_camera_pans_by_its_height_and_dollies_by_zooming() {
+        let c = orthographic(600.0);
+        assert_eq!(pan(&c, 0.0, 0.0, 512), c);
+        // A full-height drag moves the view by its height, whatever the distance.
+        let full = pan(&c, 0.0, 512.0, 512);
+        assert!(((full.eye.y - c.eye.y) - 600.0).abs() < 1e-3);
+        assert_eq!(full.eye - c.eye, full.target - c.target);
+        // The dolly zooms: the eye stays, the height scales by the dolly's factor.
+        let d = dolly(&c, 1.0);
+        assert_eq!((d.eye, d.target), (c.eye, c.target));
+        let Projection::Orthographic { height } = d.projection else {
+            panic!("{d:?}")
+        };
+        assert!((height - 600.0 * DOLLY_FACTOR_PER_STEP).abs() < 1e-3);
+        // Within the lengths a scene file takes, either way.
+        for (steps, bound) in [(1e4, MIN_LENGTH), (-1e4, MAX_COORDINATE)] {
+            let z = dolly(&c, steps);
+            assert_eq!(z.projection, Projection::Orthographic { height: bound });
+        }
+        // Orbiting keeps the distance and the projection.
+        let o = orbit(&c, 40.0, 10.0);
+        assert_eq!(o.projection, c.projection);
+        assert!((distance(&o) - distance(&c)).abs() < 1e-2);
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! vanish under a white sky; rough GGX albedo against an independent quadrature; a white sphere
 //! vanishing at three scales (which also catches self-intersection); `max_bounces = 0`; and a
 //! floor under an emitting sphere against the irradiance formula, within 5σ of the estimator's
-//! variance, which checks the cosine weighting.
+//! variance, which checks the cosine weighting; and an orthographic camera seeing a lamp head-on
+//! in exactly the pixels its extent covers, at any distance.
 
 use crate::common;
 use common::{kernel_scene, largest_deviation, render_both};
@@ -321,5 +322,58 @@ material = "m"
         let tolerance = 5.0 * variance.sqrt() + 0.003 * expected;
         eprintln!("white GGX metal, roughness {roughness}, θo = {tilt_degrees}°: rendered {mean:.4}, quadrature {expected:.4} ± {tolerance:.4}");
         assert!((mean - expected).abs() < tolerance, "{mean} vs {expected}");
+    }
+}
+
+/// An orthographic camera looking head-on (along −z, image-right +x, image-up +y) at a lamp of
+/// radiance (2, 1, 0.5) on a black background. The view is 3 units high over 24 rows and 4 wide
+/// over 32 columns, so a pixel is 0.125 units square (exact in binary), and the lamp's
+/// extent, x in [−1, 1] and y in [−0.75, 0.75], is exactly columns 8 to 23 and rows 6 to 17.
+/// Every sample sees what lies straight ahead of its point on the image plane: every pixel of
+/// the rectangle is exactly the radiance and every other pixel exactly 0, whatever the lamp's
+/// distance (a perspective camera would shrink it with distance). A wrong half-extent, a jitter
+/// not on the image plane, or rays from the eye would put lamp in other pixels or dark
+/// samples in the lamp's. The lamp reflects nothing (black), so bounces add nothing to it.
+#[test]
+fn an_orthographic_camera_sees_a_lamp_in_exactly_its_pixels() {
+    for lamp_z in [0.0, -40.0] {
+        let scene = kernel_scene(&format!(
+            r#"
+[camera]
+eye = [0.0, 0.0, 5.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+projection = "orthographic"
+height = 3.0
+[render]
+width = 32
+height = 24
+spp = 8
+max_bounces = 2
+[materials.lamp]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [1.0, 0.5, 0.25]
+strength = 2.0
+[[quads]]
+corner = [-1.0, -0.75, {lamp_z:?}]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 1.5, 0.0]
+material = "lamp"
+"#
+        ));
+        for (device, image) in render_both(&scene, 8) {
+            for y in 0..24 {
+                for x in 0..32 {
+                    let inside = (8..24).contains(&x) && (6..18).contains(&y);
+                    let expected = if inside { [2.0, 1.0, 0.5] } else { [0.0; 3] };
+                    assert_eq!(
+                        image.pixels[y * 32 + x],
+                        expected,
+                        "{device}, lamp at z = {lamp_z}: pixel ({x}, {y})"
+                    );
+                }
+            }
+        }
     }
 }

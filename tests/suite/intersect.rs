@@ -34,7 +34,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             eye: Vec3::ZERO,
             target: Vec3::Z,
             up: Vec3::Y,
-            vfov: 40.0,
+            projection: glint::scene::Projection::Perspective { vfov: 40.0 },
             aperture: 0.0,
             focus_distance: 1.0,
         },

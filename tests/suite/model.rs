@@ -82,7 +82,10 @@ fn the_cameras_match_the_files_numbers() {
         Vec3::NEG_Z,
         1e-7
     ));
-    assert_eq!(camera.vfov, c.vfov);
+    assert_eq!(
+        camera.projection,
+        glint::scene::Projection::Perspective { vfov: c.vfov }
+    );
     assert_eq!(
         (model.scene.render.width, model.scene.render.height),
         (512, 341)
@@ -495,7 +498,10 @@ fn scene_files_take_a_files_camera_and_lights() {
         Vec3::NEG_X,
         1e-6
     ));
-    assert!((scene.camera.vfov - 0.8f32.to_degrees()).abs() < 1e-5);
+    assert!(matches!(
+        scene.camera.projection,
+        glint::scene::Projection::Perspective { vfov } if (vfov - 0.8f32.to_degrees()).abs() < 1e-5
+    ));
     assert_eq!(scene.lights.len(), 3);
     let first = scene_with(d, "from = \"lc.gltf\"", "lights = false").unwrap();
     assert_eq!(first.camera.eye, Vec3::new(0.0, 1.5, 6.0));

@@ -230,6 +230,82 @@ fn vfov_outside_0_180() {
     }
 }
 
+/// `projection = "orthographic"` with the view's `height`: read, and each mistake an error
+/// naming the field: a field of view, a lens, a height that is missing, not > 0 or not finite,
+/// an unknown projection, and a height on a perspective camera.
+#[test]
+fn orthographic_camera() {
+    const ORTHOGRAPHIC: &str = "projection = \"orthographic\"\nheight = 2.5";
+    let s = parse(&edited("vfov = 40.0", ORTHOGRAPHIC)).unwrap();
+    assert_eq!(
+        s.camera.projection,
+        glint::scene::Projection::Orthographic { height: 2.5 }
+    );
+    assert_eq!(s.camera.aperture, 0.0);
+    let s = parse(&edited(
+        "vfov = 40.0",
+        "vfov = 40.0\nprojection = \"perspective\"",
+    ))
+    .unwrap();
+    assert_eq!(
+        s.camera.projection,
+        glint::scene::Projection::Perspective { vfov: 40.0 }
+    );
+
+    let orthographic = |extra: &str| edited("vfov = 40.0", &format!("{ORTHOGRAPHIC}\n{extra}"));
+    assert_error(
+        &orthographic("vfov = 40.0"),
+        Some(7),
+        &[
+            "camera.vfov",
+            "orthographic camera has no field of view",
+            "camera.height",
+        ],
+    );
+    for lens in ["aperture = 0.1", "aperture = 0.0", "focus_distance = 3.0"] {
+        let field = format!("camera.{}", lens.split(' ').next().unwrap());
+        assert_error(
+            &orthographic(lens),
+            Some(7),
+            &[&field, "orthographic camera has no lens", "depth of field"],
+        );
+    }
+    assert_error(
+        &edited("vfov = 40.0", "projection = \"orthographic\""),
+        None,
+        &["camera.height", "missing", "orthographic camera needs"],
+    );
+    for (bad, needle) in [
+        ("0.0", "> 0"),
+        ("-2", "> 0"),
+        ("nan", "finite"),
+        ("inf", "finite"),
+    ] {
+        assert_error(
+            &edited(
+                "vfov = 40.0",
+                &format!("projection = \"orthographic\"\nheight = {bad}"),
+            ),
+            Some(6),
+            &["camera.height", needle],
+        );
+    }
+    assert_error(
+        &edited("vfov = 40.0", "vfov = 40.0\nprojection = \"fisheye\""),
+        Some(6),
+        &[
+            "camera.projection",
+            "unknown projection \"fisheye\"",
+            "\"orthographic\"",
+        ],
+    );
+    assert_error(
+        &edited("vfov = 40.0", "vfov = 40.0\nheight = 2.0"),
+        Some(6),
+        &["camera.height", "orthographic", "vfov"],
+    );
+}
+
 #[test]
 fn eye_equal_to_target() {
     assert_error(
