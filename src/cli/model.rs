@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 #[derive(Args, Debug, Default, Clone)]
 pub struct ModelArgs {
     /// Model files: render through the file's N-th camera (0-based, in node order) instead of
-    /// its first perspective camera.
+    /// its first camera.
     #[arg(long, value_name = "N")]
     pub camera: Option<usize>,
     /// Model files: light the model by this equirectangular map (.hdr, .exr) instead of the

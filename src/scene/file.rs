@@ -82,7 +82,7 @@ pub(super) struct CameraToml {
     pub(super) height: Option<S<Real>>,
     /// A glTF file (relative to the scene file's folder) whose camera this is.
     pub(super) from: Option<S<String>>,
-    /// Which of its cameras (in node order); without it, the first perspective one.
+    /// Which of its cameras (in node order); without it, the first one.
     pub(super) index: Option<S<i64>>,
     pub(super) aperture: Option<S<Real>>,
     pub(super) focus_distance: Option<S<Real>>,

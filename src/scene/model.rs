@@ -1,7 +1,7 @@
 //! A model file (`.glb`, `.gltf`, `.obj`, `.ply`) as a whole scene: `glint render model.glb`.
 //!
-//! The model is placed as the file places it. The camera is the file's first perspective
-//! camera (or the one `--camera` picks), else one that frames the model's bounding sphere from
+//! The model is placed as the file places it. The camera is the file's first camera
+//! (or the one `--camera` picks), else one that frames the model's bounding sphere from
 //! the front; the file's punctual lights join it; the environment is a map file or the
 //! generated studio map (`studio.rs`). [`model_toml`](super::model_toml) writes the scene as
 //! a scene file that builds the same scene again.
@@ -178,12 +178,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
     let (width, height) = image_size(options.width, options.height, aspect);
     check_image_size(width as i64, height as i64).map_err(error)?;
     let camera = match &file_camera {
-        Some(c) => pinhole(
-            c.eye,
-            c.target(),
-            c.up,
-            Projection::Perspective { vfov: c.vfov },
-        ),
+        Some(c) => pinhole(c.eye, c.target(), c.up, c.projection),
         None => framing_camera(centre, radius, width as f64 / height as f64).map_err(error)?,
     };
 

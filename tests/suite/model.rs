@@ -3,15 +3,16 @@
 //! intensities (÷ 683) match the files' numbers (tests/models/make_lights_cameras.py), in a model
 //! scene and through `[camera] from` and `[[meshes]] lights`; `--print-scene` round-trips to the
 //! same `Scene` and the same PNG bytes; a bare `.glb`, `.ply` and `.obj` fill the frame; bad
-//! lights and `--camera 7` exit 2 naming the field; assimp-testmodels' Cameras.gltf is read
-//! where it is installed.
+//! lights and `--camera 7` exit 2 naming the field; an orthographic camera (xmag, ymag) renders,
+//! round-trips and refuses bad magnifications; assimp-testmodels' Cameras.gltf is read where it
+//! is installed.
 
 use glam::{Mat4, Vec3};
 use glint::image::output::Image;
 use glint::scene::light::{Light, LightKind};
 use glint::scene::mesh::{gltf_camera, gltf_lights, LUMENS_PER_WATT};
 use glint::scene::model::{load_model, ModelOptions};
-use glint::scene::Scene;
+use glint::scene::{Projection, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -46,6 +47,14 @@ fn close(a: Vec3, b: Vec3, tolerance: f32) -> bool {
     (a - b).abs().max_element() <= tolerance
 }
 
+/// A perspective camera's field of view.
+fn vfov(projection: Projection) -> f32 {
+    match projection {
+        Projection::Perspective { vfov } => vfov,
+        other => panic!("not a perspective camera: {other:?}"),
+    }
+}
+
 #[test]
 fn the_cameras_match_the_files_numbers() {
     let path = lights_cameras();
@@ -54,7 +63,7 @@ fn the_cameras_match_the_files_numbers() {
     assert_eq!(c.eye, Vec3::new(0.0, 1.5, 6.0));
     assert_eq!(c.forward, Vec3::NEG_Z);
     assert_eq!(c.up, Vec3::Y);
-    assert!((c.vfov - 0.6f32.to_degrees()).abs() < 1e-5, "{}", c.vfov);
+    assert!((vfov(c.projection) - 0.6f32.to_degrees()).abs() < 1e-5);
     assert_eq!(c.aspect, Some(1.5));
 
     // A child of a translated node, turned +90° about +y: at (4 + 1, 2, 0), looking along −x.
@@ -67,7 +76,7 @@ fn the_cameras_match_the_files_numbers() {
     );
     assert!(close(side.forward, Vec3::NEG_X, 1e-6), "{}", side.forward);
     assert!(close(side.up, Vec3::Y, 1e-6), "{}", side.up);
-    assert!((side.vfov - 0.8f32.to_degrees()).abs() < 1e-5);
+    assert!((vfov(side.projection) - 0.8f32.to_degrees()).abs() < 1e-5);
     assert_eq!(side.aspect, None);
 
     let e = gltf_camera(&path, Some(2)).unwrap_err();
@@ -82,10 +91,7 @@ fn the_cameras_match_the_files_numbers() {
         Vec3::NEG_Z,
         1e-7
     ));
-    assert_eq!(
-        camera.projection,
-        glint::scene::Projection::Perspective { vfov: c.vfov }
-    );
+    assert_eq!(camera.projection, c.projection);
     assert_eq!(
         (model.scene.render.width, model.scene.render.height),
         (512, 341)
@@ -217,7 +223,7 @@ fn debians_cameras_gltf_reads() {
     let c = gltf_camera(path, None).unwrap().unwrap();
     assert_eq!(c.eye, Vec3::new(0.5, 0.5, 3.0));
     assert_eq!(c.forward, Vec3::NEG_Z);
-    assert!((c.vfov - 0.7f32.to_degrees()).abs() < 1e-5);
+    assert!((vfov(c.projection) - 0.7f32.to_degrees()).abs() < 1e-5);
     assert_eq!(c.aspect, Some(1.0));
 
     let run = glint(&["render", CAMERAS_GLTF, "--camera", "7", "--print-scene"]);
@@ -227,9 +233,14 @@ fn debians_cameras_gltf_reads() {
     for needle in ["Cameras.gltf", "--camera 7", "2 cameras"] {
         assert!(lines[0].contains(needle), "{lines:?} lacks {needle}");
     }
+    // Camera 1 is orthographic, xmag = ymag = 1: a view 2 high.
     let run = glint(&["render", CAMERAS_GLTF, "--camera", "1", "--print-scene"]);
-    assert_eq!(run.status.code(), Some(2));
-    assert!(stderr_lines(&run)[0].contains("orthographic"));
+    assert!(run.status.success(), "{:?}", stderr_lines(&run));
+    let toml = String::from_utf8(run.stdout).unwrap();
+    assert!(
+        toml.contains("projection = \"orthographic\"\nheight = 2.0\n"),
+        "{toml}"
+    );
 
     // It has no material: the model gets the default one, and renders.
     let dir = tempfile::tempdir().unwrap();
@@ -476,6 +487,115 @@ fn a_bare_model_fills_the_frame() {
     }
 }
 
+/// lights-cameras.gltf with its camera 0 made orthographic, `xmag` and `ymag` as given.
+fn orthographic(dir: &Path, name: &str, xmag: f64, ymag: f64) -> PathBuf {
+    edited(dir, name, |j| {
+        j["cameras"][0] = serde_json::json!({
+            "type": "orthographic",
+            "orthographic": {"xmag": xmag, "ymag": ymag, "znear": 0.1, "zfar": 100.0}
+        })
+    })
+}
+
+/// A glTF file's orthographic camera: 2·ymag high, xmag / ymag its aspect ratio (a model
+/// scene's image shape), rendered on both devices as a model file, written by `--print-scene`
+/// as `projection = "orthographic"` and `height`, which renders the same image, and taken by a
+/// scene file's `[camera] from`; magnifications ≤ 0 exit 2 naming the field, and a lens on it
+/// is refused.
+#[test]
+fn a_gltf_files_orthographic_camera_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let path = orthographic(d, "ortho.gltf", 3.0, 2.0);
+    let c = gltf_camera(&path, None).unwrap().expect("a camera");
+    assert_eq!((c.node, c.camera), (2, 0));
+    assert_eq!(c.eye, Vec3::new(0.0, 1.5, 6.0));
+    assert_eq!(c.projection, Projection::Orthographic { height: 4.0 });
+    assert_eq!(c.aspect, Some(1.5));
+    let model = load_model(&path, &ModelOptions::default()).unwrap();
+    assert_eq!(model.scene.camera.projection, c.projection);
+    assert_eq!(model.scene.camera.aperture, 0.0);
+    assert_eq!(
+        (model.scene.render.width, model.scene.render.height),
+        (512, 341)
+    );
+
+    for device in ["--cpu", "--gpu"] {
+        let out = d.join(format!("ortho{device}.png"));
+        let run = glint(&[
+            "render",
+            path.to_str().unwrap(),
+            device,
+            "--spp",
+            "2",
+            "--width",
+            "24",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(run.status.success(), "{device}: {:?}", stderr_lines(&run));
+        assert!(std::fs::metadata(&out).unwrap().len() > 0);
+    }
+
+    let run = glint(&["render", path.to_str().unwrap(), "--print-scene"]);
+    assert!(run.status.success(), "{:?}", stderr_lines(&run));
+    let toml = String::from_utf8(run.stdout).unwrap();
+    assert!(
+        toml.contains("projection = \"orthographic\"\nheight = 4.0\n"),
+        "{toml}"
+    );
+    assert!(!toml.contains("vfov"), "{toml}");
+    let text = glint::scene::model_toml::model_toml(&model);
+    std::fs::write(d.join("ortho.toml"), text).unwrap();
+    assert_eq!(Scene::load(&d.join("ortho.toml")).unwrap(), model.scene);
+    assert_round_trip(&path, &["--width", "40"]);
+
+    // A scene file's [camera] from takes it, without a lens.
+    let write = |camera: &str| {
+        let text = format!(
+            "[camera]\nfrom = \"ortho.gltf\"\n{camera}\n\n[render]\nwidth = 8\nheight = 8\n\
+             spp = 1\nmax_bounces = 1\n"
+        );
+        let scene = d.join("s.toml");
+        std::fs::write(&scene, text).unwrap();
+        Scene::load(&scene).map_err(|e| e.to_string())
+    };
+    assert_eq!(write("").unwrap().camera.projection, c.projection);
+    for (camera, needles) in [
+        (
+            "aperture = 0.5",
+            &[
+                "s.toml",
+                "camera.aperture",
+                "orthographic camera has no lens",
+            ][..],
+        ),
+        ("height = 3.0", &["camera.height", "not both"][..]),
+    ] {
+        let e = write(camera).unwrap_err();
+        for needle in needles {
+            assert!(e.contains(needle), "{e} lacks {needle}");
+        }
+    }
+
+    for (xmag, ymag, field) in [
+        (3.0, 0.0, "cameras[0].orthographic.ymag"),
+        (3.0, -2.0, "cameras[0].orthographic.ymag"),
+        (-3.0, 2.0, "cameras[0].orthographic.xmag"),
+        (3.0, 1e-30, "cameras[0].orthographic.ymag"),
+    ] {
+        let bad = orthographic(d, "bad.gltf", xmag, ymag);
+        let run = glint(&["render", bad.to_str().unwrap(), "--print-scene"]);
+        let lines = stderr_lines(&run);
+        assert_eq!(run.status.code(), Some(2), "{lines:?}");
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        for needle in ["bad.gltf", field] {
+            assert!(lines[0].contains(needle), "{lines:?} lacks {needle:?}");
+        }
+        assert!(run.stdout.is_empty());
+    }
+}
+
 fn scene_with(dir: &Path, camera: &str, mesh_extra: &str) -> Result<Scene, String> {
     std::fs::copy(lights_cameras(), dir.join("lc.gltf")).unwrap();
     let text = format!(
@@ -498,10 +618,7 @@ fn scene_files_take_a_files_camera_and_lights() {
         Vec3::NEG_X,
         1e-6
     ));
-    assert!(matches!(
-        scene.camera.projection,
-        glint::scene::Projection::Perspective { vfov } if (vfov - 0.8f32.to_degrees()).abs() < 1e-5
-    ));
+    assert!((vfov(scene.camera.projection) - 0.8f32.to_degrees()).abs() < 1e-5);
     assert_eq!(scene.lights.len(), 3);
     let first = scene_with(d, "from = \"lc.gltf\"", "lights = false").unwrap();
     assert_eq!(first.camera.eye, Vec3::new(0.0, 1.5, 6.0));

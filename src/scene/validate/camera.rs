@@ -187,7 +187,7 @@ fn given(
     Ok((eye, target_value, up, projection))
 }
 
-/// The camera of the glTF file `from` names: its `index`-th, or its first perspective one.
+/// The camera of the glTF file `from` names: its `index`-th, or its first one.
 fn from_file(
     camera: &CameraToml,
     from: &S<String>,
@@ -206,8 +206,8 @@ fn from_file(
             return fail(
                 span,
                 format!("camera.{name}"),
-                "give either camera.from (a glTF file's camera) or eye, target, up and vfov \
-                 (or projection and height), not both",
+                "give either camera.from (a glTF file's camera, its projection included) or \
+                 eye, target, up and vfov (or projection and height), not both",
             );
         }
     }
@@ -253,13 +253,8 @@ fn from_file(
         return fail(
             from.span(),
             "camera.from",
-            format!("{file}: the file has no perspective camera"),
+            format!("{file}: the file has no camera"),
         );
     };
-    Ok((
-        c.eye,
-        c.target(),
-        c.up,
-        Projection::Perspective { vfov: c.vfov },
-    ))
+    Ok((c.eye, c.target(), c.up, c.projection))
 }

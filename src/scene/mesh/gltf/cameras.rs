@@ -1,18 +1,25 @@
 //! A glTF file's cameras: the views its nodes place. A glTF camera looks down its node's
 //! local −z axis with +y up; a perspective camera gives its vertical field of view (`yfov`,
-//! radians) and may give an aspect ratio (width / height). `znear` and `zfar` do not apply to
-//! a path tracer and are ignored.
+//! radians) and may give an aspect ratio (width / height). An orthographic camera gives its
+//! view's half-width and half-height (`xmag`, `ymag`, in the node's units): its view is 2·ymag
+//! high (the scene file's `height`), and xmag / ymag is its aspect ratio, which plays the part
+//! of a perspective camera's `aspectRatio`: it sets a model scene's image shape, and a scene
+//! file's `[render]` size overrides it, the width following the image's aspect (so xmag is met
+//! exactly where the image's shape is xmag / ymag). `znear` and `zfar` do not apply to a path
+//! tracer and are ignored: rays start on the plane through the node's origin (an orthographic
+//! camera's) or at its origin (a perspective one's), and go on without end.
 
 use super::document::{exists, read_document};
 use super::nodes::placed_nodes;
-use crate::scene::limits::{MAX_COORDINATE, MIN_SINE};
+use crate::scene::limits::{MAX_COORDINATE, MIN_LENGTH, MIN_SINE};
+use crate::scene::Projection;
 use glam::Vec3;
 use gltf::json;
 use json::camera::Type;
 use json::validation::Checked;
 use std::path::Path;
 
-/// A perspective camera as the file places it.
+/// A camera as the file places it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FileCamera {
     /// The node that places it, and its index in the file's `cameras`.
@@ -23,9 +30,11 @@ pub struct FileCamera {
     pub forward: Vec3,
     /// The node's +y axis, unit.
     pub up: Vec3,
-    /// Vertical field of view, degrees, in (0, 180).
-    pub vfov: f32,
-    /// `aspectRatio` (width / height), where the file gives one.
+    /// The vertical field of view in degrees (`yfov`), or the orthographic view's height
+    /// (2·`ymag`).
+    pub projection: Projection,
+    /// Width / height: a perspective camera's `aspectRatio`, where the file gives one; an
+    /// orthographic camera's `xmag / ymag`.
     pub aspect: Option<f32>,
 }
 
@@ -45,9 +54,9 @@ struct Placed {
 }
 
 /// Camera `index` of the file (the `index`-th node, in node order, of the default scene that
-/// places a camera) or, without an index, its first perspective camera; `None` where the file
-/// has no perspective camera and no index was asked for. The error is a sentence naming the
-/// element (`cameras[1]`), for the caller to put after the file's name.
+/// places a camera) or, without an index, its first one; `None` where the file has no camera
+/// and no index was asked for. The error is a sentence naming the element (`cameras[1]`), for
+/// the caller to put after the file's name.
 pub fn gltf_camera(path: &Path, index: Option<usize>) -> Result<Option<FileCamera>, String> {
     let (root, _) = read_document(path)?;
     let mut placed = Vec::new();
@@ -68,20 +77,9 @@ pub fn gltf_camera(path: &Path, index: Option<usize>) -> Result<Option<FileCamer
             let Some(p) = placed.get(i) else {
                 return Err(no_such_camera(i, placed.len()));
             };
-            if !is_perspective(&root.cameras[p.camera]) {
-                return Err(format!(
-                    "camera {i} (cameras[{}], placed by nodes[{}]) is orthographic; glint renders \
-                     perspective cameras only",
-                    p.camera, p.node
-                ));
-            }
             view(&root, p).map(Some)
         }
-        None => placed
-            .iter()
-            .find(|p| is_perspective(&root.cameras[p.camera]))
-            .map(|p| view(&root, p))
-            .transpose(),
+        None => placed.first().map(|p| view(&root, p)).transpose(),
     }
 }
 
@@ -96,32 +94,72 @@ pub fn no_such_camera(index: usize, count: usize) -> String {
     format!("there is no camera {index}: the file has {which}")
 }
 
-fn is_perspective(c: &json::Camera) -> bool {
-    matches!(c.type_, Checked::Valid(Type::Perspective))
+/// A camera's projection and aspect ratio (width / height, where it has one), checked.
+fn projection(camera: &json::Camera, field: &str) -> Result<(Projection, Option<f32>), String> {
+    match camera.type_ {
+        Checked::Valid(Type::Perspective) => {
+            let perspective = camera.perspective.as_ref().ok_or_else(|| {
+                format!("{field}: a perspective camera needs a \"perspective\" object")
+            })?;
+            let yfov = perspective.yfov;
+            let vfov = yfov.to_degrees();
+            if !(vfov > 0.0 && vfov < 180.0) {
+                return Err(format!(
+                    "{field}.perspective.yfov: must be in (0, π) radians, got {yfov}"
+                ));
+            }
+            let aspect = match perspective.aspect_ratio {
+                Some(a) if !(a.is_finite() && a > 0.0) => {
+                    return Err(format!(
+                        "{field}.perspective.aspectRatio: must be a finite number > 0, got {a}"
+                    ));
+                }
+                a => a,
+            };
+            Ok((Projection::Perspective { vfov }, aspect))
+        }
+        Checked::Valid(Type::Orthographic) => {
+            let orthographic = camera.orthographic.as_ref().ok_or_else(|| {
+                format!("{field}: an orthographic camera needs an \"orthographic\" object")
+            })?;
+            // glTF asks for non-zero magnifications and advises against negative ones (they
+            // would mirror the image); glint takes positive ones only, within the range of
+            // lengths the scene file's `height` takes (2·ymag is the view's height).
+            let magnification = |name: &str, value: f32| {
+                let half = if name == "xmag" { "width" } else { "height" };
+                if !(value.is_finite() && value > 0.0) {
+                    return Err(format!(
+                        "{field}.orthographic.{name}: must be a finite number > 0 (the view's \
+                         half-{half}), got {value}"
+                    ));
+                }
+                let (min, max) = (0.5 * MIN_LENGTH, 0.5 * MAX_COORDINATE);
+                if !(min..=max).contains(&value) {
+                    return Err(format!(
+                        "{field}.orthographic.{name}: must be in [{min:e}, {max:e}] (the \
+                         numeric range glint supports), got {value:e}"
+                    ));
+                }
+                Ok(value)
+            };
+            let xmag = magnification("xmag", orthographic.xmag)?;
+            let ymag = magnification("ymag", orthographic.ymag)?;
+            let aspect = xmag / ymag;
+            Ok((
+                Projection::Orthographic { height: 2.0 * ymag },
+                Some(aspect),
+            ))
+        }
+        Checked::Invalid => Err(format!(
+            "{field}.type: must be \"perspective\" or \"orthographic\""
+        )),
+    }
 }
 
-/// A placed perspective camera's view, checked.
+/// A placed camera's view, checked.
 fn view(root: &json::Root, p: &Placed) -> Result<FileCamera, String> {
     let field = format!("cameras[{}]", p.camera);
-    let perspective = root.cameras[p.camera]
-        .perspective
-        .as_ref()
-        .ok_or_else(|| format!("{field}: a perspective camera needs a \"perspective\" object"))?;
-    let yfov = perspective.yfov;
-    let vfov = yfov.to_degrees();
-    if !(vfov > 0.0 && vfov < 180.0) {
-        return Err(format!(
-            "{field}.perspective.yfov: must be in (0, π) radians, got {yfov}"
-        ));
-    }
-    let aspect = match perspective.aspect_ratio {
-        Some(a) if !(a.is_finite() && a > 0.0) => {
-            return Err(format!(
-                "{field}.perspective.aspectRatio: must be a finite number > 0, got {a}"
-            ));
-        }
-        a => a,
-    };
+    let (projection, aspect) = projection(&root.cameras[p.camera], &field)?;
     let eye = p.transform.transform_point3(Vec3::ZERO);
     if !eye.is_finite() || eye.abs().max_element() > MAX_COORDINATE {
         return Err(format!(
@@ -153,7 +191,7 @@ fn view(root: &json::Root, p: &Placed) -> Result<FileCamera, String> {
         eye,
         forward: forward.as_vec3(),
         up: up.as_vec3(),
-        vfov,
+        projection,
         aspect,
     })
 }
