@@ -34,6 +34,36 @@ def test_camera_edit_equals_the_edited_file(cornell, tmp_path):
     assert np.array_equal(after, glint.render(edited, **SETTINGS))
 
 
+def test_an_orthographic_camera_equals_the_edited_file(cornell, tmp_path):
+    """projection = "orthographic" with the view's height, set as a whole camera table (each
+    field alone would not validate: vfov and height exclude each other)."""
+    scene = glint.load(cornell)
+    perspective = glint.render(scene, **SETTINGS)
+    camera = scene.camera.to_dict()
+    del camera["vfov"]
+    camera.update(projection="orthographic", height=600.0)
+    scene.camera = camera
+    assert scene.camera.projection == "orthographic" and scene.camera.height == 600.0
+    path = edited_file(
+        tmp_path, cornell, "vfov = 40.0", 'projection = "orthographic"\nheight = 600.0'
+    )
+    edited = glint.load_string(path.read_text(), path=str(cornell))
+    assert scene == edited
+    image = glint.render(scene, **SETTINGS)
+    assert not np.array_equal(image, perspective)
+    assert np.array_equal(image, glint.render(edited, **SETTINGS))
+    for field, value, message in [
+        ("vfov", 40.0, "no field of view"),
+        ("aperture", 10.0, "no lens"),
+        ("height", -1.0, "> 0"),
+        ("projection", "fisheye", "unknown projection"),
+    ]:
+        with pytest.raises(glint.SceneError, match=message) as error:
+            scene.camera[field] = value
+        assert error.value.field == f"camera.{field}"
+    assert scene == edited
+
+
 def test_material_edit_equals_the_edited_file(cornell, tmp_path):
     scene = glint.load(cornell)
     scene.materials["white"].color = (0.5, 0.5, 0.5)
