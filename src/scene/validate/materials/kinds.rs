@@ -1,0 +1,177 @@
+//! A material's `type` and the parameters of the simple kinds (diffuse, specular, metal,
+//! dielectric; `pbr` in `pbr.rs`), and which fields each kind takes.
+
+use super::super::fields::{fail, real, FieldError};
+use super::pbr::pbr_kind;
+use crate::scene::file::{MaterialToml, Real, RoughnessToml, S};
+use crate::scene::limits::{MAX_IOR, MIN_IOR};
+use crate::scene::texture::TextureSet;
+use crate::scene::MaterialKind;
+use std::path::Path;
+
+/// The kind `type` names, with its parameters checked (a `pbr` material's textures added to
+/// `textures`).
+pub(super) fn material_kind(
+    m: &MaterialToml,
+    field: &dyn Fn(&str) -> String,
+    folder: &Path,
+    textures: &mut TextureSet,
+) -> Result<MaterialKind, FieldError> {
+    match m.kind.get_ref().as_str() {
+        "diffuse" => Ok(MaterialKind::Diffuse),
+        "specular" => Ok(MaterialKind::Specular),
+        "metal" => metal_kind(m, field),
+        "dielectric" => dielectric_kind(m, field),
+        "pbr" => pbr_kind(m, field, folder, textures),
+        other => fail(
+            m.kind.span(),
+            field("type"),
+            format!(
+                "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\", \"pbr\""
+            ),
+        ),
+    }
+}
+
+/// A metal's `roughness` (required): a constant in [0, 1] or a texture (read with the other
+/// textures; the constant is then unused).
+fn metal_kind(
+    m: &MaterialToml,
+    field: &dyn Fn(&str) -> String,
+) -> Result<MaterialKind, FieldError> {
+    let r = required(m, &m.roughness, "roughness", "metal", field)?;
+    let roughness = match r.get_ref() {
+        RoughnessToml::Value(v) => real(&S::new(r.span(), *v), &field("roughness"))?,
+        // A texture (read below); the constant is unused.
+        RoughnessToml::Other(_) => 1.0,
+    };
+    if !(0.0..=1.0).contains(&roughness) {
+        return fail(
+            r.span(),
+            field("roughness"),
+            format!("must be in [0, 1] (0 = mirror), got {roughness}"),
+        );
+    }
+    Ok(MaterialKind::Metal { roughness })
+}
+
+/// A dielectric's `ior` (required).
+fn dielectric_kind(
+    m: &MaterialToml,
+    field: &dyn Fn(&str) -> String,
+) -> Result<MaterialKind, FieldError> {
+    let ior = ior_in_range(required(m, &m.ior, "ior", "dielectric", field)?, field)?;
+    Ok(MaterialKind::Dielectric { ior })
+}
+
+/// A field this kind (`what`) of material needs; its absence fails at the material's `type`.
+fn required<'a, T>(
+    m: &MaterialToml,
+    x: &'a Option<S<T>>,
+    name: &str,
+    what: &str,
+    field: &dyn Fn(&str) -> String,
+) -> Result<&'a S<T>, FieldError> {
+    match x {
+        Some(x) => Ok(x),
+        None => fail(
+            m.kind.span(),
+            field(name),
+            format!("missing: a {what} needs {name}"),
+        ),
+    }
+}
+
+/// An index of refraction (`ior`) within the range glint supports.
+pub(super) fn ior_in_range(x: &S<Real>, field: &dyn Fn(&str) -> String) -> Result<f32, FieldError> {
+    let ior = real(x, &field("ior"))?;
+    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+        return fail(
+            x.span(),
+            field("ior"),
+            format!(
+                "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
+                 numeric range glint supports), got {ior}"
+            ),
+        );
+    }
+    Ok(ior)
+}
+
+/// A field that does not apply to the material's kind is most likely a mistake: say so.
+pub(super) fn check_fields_apply(
+    m: &MaterialToml,
+    kind: &MaterialKind,
+    field: &dyn Fn(&str) -> String,
+) -> Result<(), FieldError> {
+    let pbr = matches!(kind, MaterialKind::Pbr { .. });
+    for (span, name, applies) in [
+        (
+            m.roughness.as_ref().map(|r| r.span()),
+            "roughness",
+            matches!(kind, MaterialKind::Metal { .. } | MaterialKind::Pbr { .. }),
+        ),
+        (
+            m.ior.as_ref().map(|r| r.span()),
+            "ior",
+            matches!(
+                kind,
+                MaterialKind::Dielectric { .. } | MaterialKind::Pbr { .. }
+            ),
+        ),
+        (
+            m.color.as_ref().map(|r| r.span()),
+            "color",
+            !matches!(kind, MaterialKind::Pbr { .. }),
+        ),
+        (m.base_color.as_ref().map(|r| r.span()), "base_color", pbr),
+        (m.metallic.as_ref().map(|r| r.span()), "metallic", pbr),
+        (m.specular.as_ref().map(|r| r.span()), "specular", pbr),
+        (
+            m.specular_color.as_ref().map(|r| r.span()),
+            "specular_color",
+            pbr,
+        ),
+        (
+            m.transmission.as_ref().map(|r| r.span()),
+            "transmission",
+            pbr,
+        ),
+        (
+            m.attenuation_color.as_ref().map(|r| r.span()),
+            "attenuation_color",
+            pbr,
+        ),
+        (
+            m.attenuation_distance.as_ref().map(|r| r.span()),
+            "attenuation_distance",
+            pbr,
+        ),
+        (m.clearcoat.as_ref().map(|r| r.span()), "clearcoat", pbr),
+        (
+            m.clearcoat_roughness.as_ref().map(|r| r.span()),
+            "clearcoat_roughness",
+            pbr,
+        ),
+        (
+            m.clearcoat_normal_map.as_ref().map(|r| r.span()),
+            "clearcoat_normal_map",
+            pbr,
+        ),
+        (m.sheen_color.as_ref().map(|r| r.span()), "sheen_color", pbr),
+        (
+            m.sheen_roughness.as_ref().map(|r| r.span()),
+            "sheen_roughness",
+            pbr,
+        ),
+    ] {
+        if let (Some(span), false) = (span, applies) {
+            return fail(
+                span,
+                field(name),
+                format!("{name} does not apply to a {} material", m.kind.get_ref()),
+            );
+        }
+    }
+    Ok(())
+}
