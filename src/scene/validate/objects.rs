@@ -45,7 +45,7 @@ fn opaque_only_warnings(spheres: &[Sphere], quads: &[Quad], materials: &[Materia
 }
 
 /// The scene's spheres, quads and meshes (read relative to `folder`; their own materials are
-/// added to `materials`).
+/// added to `materials`), each list checked in the order of the file.
 pub(super) fn validate_objects(
     spheres_toml: &[S<SphereToml>],
     quads_toml: &[S<QuadToml>],
@@ -53,98 +53,122 @@ pub(super) fn validate_objects(
     folder: &Path,
     materials: &mut Materials,
 ) -> Result<Objects, FieldError> {
-    let mut spheres = Vec::new();
-    for (i, s) in spheres_toml.iter().enumerate() {
-        let s = s.get_ref();
-        let field = |f: &str| format!("spheres[{i}].{f}");
-        let center = coordinates(&s.center, &field("center"))?;
-        let radius = real(&s.radius, &field("radius"))?;
-        if radius <= 0.0 {
-            return fail(
-                s.radius.span(),
-                field("radius"),
-                format!("must be > 0, got {radius}"),
-            );
-        }
-        length_in_range(&s.radius, &field("radius"), radius, MIN_LENGTH)?;
-        let material = materials.reference(&s.material, field("material"))?;
-        spheres.push(Sphere {
-            center,
-            radius,
-            material,
-        });
-    }
-    let mut quads = Vec::new();
-    for (i, q) in quads_toml.iter().enumerate() {
-        let q = q.get_ref();
-        let field = |f: &str| format!("quads[{i}].{f}");
-        let corner = coordinates(&q.corner, &field("corner"))?;
-        let u = coordinates(&q.u, &field("u"))?;
-        let v = coordinates(&q.v, &field("v"))?;
-        // Scale-relative: the angle between the edges, not the area against a fixed bound.
-        if u == Vec3::ZERO || v == Vec3::ZERO || sine_between(u, v) <= MIN_SINE {
-            return fail(
-                q.v.span(),
-                field("v"),
-                format!("degenerate quad: edges u = {u} and v = {v} are parallel or zero"),
-            );
-        }
-        for (edge, name, span) in [(u, "u", q.u.span()), (v, "v", q.v.span())] {
-            let length = edge.as_dvec3().length();
-            if length < MIN_LENGTH as f64 {
-                return fail(
-                    span,
-                    field(name),
-                    format!(
-                        "the edge is {length:e} long, shorter than {MIN_LENGTH:e} (the \
-                         numeric range glint supports)"
-                    ),
-                );
-            }
-        }
-        let material = materials.reference(&q.material, field("material"))?;
-        quads.push(Quad {
-            corner,
-            u,
-            v,
-            material,
-        });
-    }
-    let mut triangles = Vec::new();
-    let mut instanced = Vec::new();
-    let (mut unique_triangles, mut instance_count) = (0usize, 0usize);
-    let mut lights = Vec::new();
-    let mut warnings = opaque_only_warnings(&spheres, &quads, &materials.list);
+    let spheres = spheres_toml
+        .iter()
+        .enumerate()
+        .map(|(i, s)| validate_sphere(s.get_ref(), i, materials))
+        .collect::<Result<Vec<_>, _>>()?;
+    let quads = quads_toml
+        .iter()
+        .enumerate()
+        .map(|(i, q)| validate_quad(q.get_ref(), i, materials))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut meshes = Meshes {
+        triangles: Vec::new(),
+        instanced: Vec::new(),
+        unique_triangles: 0,
+        instance_count: 0,
+        lights: Vec::new(),
+        warnings: opaque_only_warnings(&spheres, &quads, &materials.list),
+    };
     for (i, m) in meshes_toml.iter().enumerate() {
-        let m = m.get_ref();
-        let field = |f: &str| format!("meshes[{i}].{f}");
-        let translate = match &m.translate {
-            Some(t) => coordinates(t, &field("translate"))?,
-            None => Vec3::ZERO,
-        };
-        let rotate = match &m.rotate {
-            Some(r) => vec3(r, &field("rotate"))?,
-            None => Vec3::ZERO,
-        };
-        let scale = match &m.scale {
-            None => Vec3::ONE,
-            Some(s) => {
-                let v = match s.get_ref() {
-                    ScaleToml::Uniform(r) => Vec3::splat(r.0 as f32),
-                    ScaleToml::PerAxis(a) => Vec3::new(a[0].0 as f32, a[1].0 as f32, a[2].0 as f32),
-                };
-                positive_scale(v, s.span(), &field("scale"))?
-            }
-        };
+        meshes.add(m.get_ref(), i, folder, materials)?;
+    }
+    Ok(Objects {
+        spheres,
+        quads,
+        triangles: meshes.triangles,
+        instanced: meshes.instanced,
+        lights: meshes.lights,
+        warnings: meshes.warnings,
+    })
+}
+
+/// `spheres[i]`: its center, radius (> 0, within the coordinate range) and material.
+fn validate_sphere(s: &SphereToml, i: usize, materials: &Materials) -> Result<Sphere, FieldError> {
+    let field = |f: &str| format!("spheres[{i}].{f}");
+    let center = coordinates(&s.center, &field("center"))?;
+    let radius = real(&s.radius, &field("radius"))?;
+    if radius <= 0.0 {
+        return fail(
+            s.radius.span(),
+            field("radius"),
+            format!("must be > 0, got {radius}"),
+        );
+    }
+    length_in_range(&s.radius, &field("radius"), radius, MIN_LENGTH)?;
+    let material = materials.reference(&s.material, field("material"))?;
+    Ok(Sphere {
+        center,
+        radius,
+        material,
+    })
+}
+
+/// `quads[i]`: its corner, two edges that span a parallelogram (neither parallel nor too
+/// short) and material.
+fn validate_quad(q: &QuadToml, i: usize, materials: &Materials) -> Result<Quad, FieldError> {
+    let field = |f: &str| format!("quads[{i}].{f}");
+    let corner = coordinates(&q.corner, &field("corner"))?;
+    let u = coordinates(&q.u, &field("u"))?;
+    let v = coordinates(&q.v, &field("v"))?;
+    // Scale-relative: the angle between the edges, not the area against a fixed bound.
+    if u == Vec3::ZERO || v == Vec3::ZERO || sine_between(u, v) <= MIN_SINE {
+        return fail(
+            q.v.span(),
+            field("v"),
+            format!("degenerate quad: edges u = {u} and v = {v} are parallel or zero"),
+        );
+    }
+    for (edge, name, span) in [(u, "u", q.u.span()), (v, "v", q.v.span())] {
+        let length = edge.as_dvec3().length();
+        if length < MIN_LENGTH as f64 {
+            return fail(
+                span,
+                field(name),
+                format!(
+                    "the edge is {length:e} long, shorter than {MIN_LENGTH:e} (the \
+                     numeric range glint supports)"
+                ),
+            );
+        }
+    }
+    let material = materials.reference(&q.material, field("material"))?;
+    Ok(Quad {
+        corner,
+        u,
+        v,
+        material,
+    })
+}
+
+/// The `[[meshes]]` read so far, and the counts the scene's limits apply to.
+struct Meshes {
+    triangles: Vec<Triangle>,
+    instanced: Vec<InstancedMesh>,
+    /// The triangles of `instanced`, each counted once.
+    unique_triangles: usize,
+    /// The placements of `instanced`, all together.
+    instance_count: usize,
+    lights: Vec<Light>,
+    warnings: Vec<String>,
+}
+
+impl Meshes {
+    /// `meshes[i]`: its transform, material and instances checked, then its file read (its
+    /// materials added to `materials`), with the glTF file's lights unless `lights = false`.
+    fn add(
+        &mut self,
+        m: &MeshToml,
+        i: usize,
+        folder: &Path,
+        materials: &mut Materials,
+    ) -> Result<(), FieldError> {
+        let field = &|f: &str| format!("meshes[{i}].{f}");
+        let transform = mesh_transform(m, field)?;
         let material = match &m.material {
             Some(name) => Some(materials.reference(name, field("material"))?),
             None => None,
-        };
-        let file = m.file.get_ref();
-        let transform = MeshTransform {
-            scale,
-            rotate_degrees: rotate,
-            translate,
         };
         // The mesh's own transform first, then each instance's.
         let placements: Vec<Mat4> = match &m.instances {
@@ -154,6 +178,7 @@ pub(super) fn validate_objects(
                 .map(|i| i.matrix() * transform.matrix())
                 .collect(),
         };
+        let file = m.file.get_ref();
         // What is placed two or more times (by `instances` or by the file itself) comes back
         // stored once where its materials allow (src/scene/mesh/reuse.rs), the rest copied.
         let loaded = mesh::load_placed(
@@ -166,12 +191,36 @@ pub(super) fn validate_objects(
             &mut materials.textures,
         )
         .or_else(|message| fail(m.file.span(), field("file"), message))?;
-        warnings.extend(loaded.warnings);
-        triangles.extend(loaded.triangles);
-        for mesh in loaded.instanced {
-            unique_triangles += mesh.triangles.len();
-            instance_count += mesh.placements.len();
-            if instance_count > mesh::MAX_INSTANCES {
+        self.warnings.extend(loaded.warnings);
+        self.triangles.extend(loaded.triangles);
+        self.add_instanced(loaded.instanced, m, field)?;
+        if m.lights.unwrap_or(true) && mesh::is_gltf(Path::new(file)) {
+            self.add_gltf_lights(m, &placements, folder, field)?;
+        }
+        if self.triangles.len() + self.unique_triangles > mesh::MAX_TRIANGLES {
+            return fail(
+                m.file.span(),
+                field("file"),
+                format!(
+                    "the scene's meshes hold more than {} triangles",
+                    mesh::MAX_TRIANGLES
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    /// The meshes `m` placed more than once, within the scene's limit on instances.
+    fn add_instanced(
+        &mut self,
+        instanced: Vec<InstancedMesh>,
+        m: &MeshToml,
+        field: &dyn Fn(&str) -> String,
+    ) -> Result<(), FieldError> {
+        for mesh in instanced {
+            self.unique_triangles += mesh.triangles.len();
+            self.instance_count += mesh.placements.len();
+            if self.instance_count > mesh::MAX_INSTANCES {
                 let (span, name) = match &m.instances {
                     Some(list) => (list.span(), field("instances")),
                     None => (m.file.span(), field("file")),
@@ -186,43 +235,67 @@ pub(super) fn validate_objects(
                     ),
                 );
             }
-            instanced.push(mesh);
+            self.instanced.push(mesh);
         }
-        if m.lights.unwrap_or(true) && mesh::is_gltf(Path::new(file)) {
-            for (p, placement) in placements.iter().enumerate() {
-                let (mut file_lights, file_warnings) =
-                    mesh::gltf_lights(&folder.join(file), *placement).or_else(|message| {
-                        fail(m.file.span(), field("file"), format!("{file}: {message}"))
-                    })?;
-                // The same warnings for every placement: said once. A file without lights
-                // is not read again for every instance.
-                if p == 0 {
-                    warnings.extend(file_warnings.into_iter().map(|w| format!("{file}: {w}")));
-                    if file_lights.is_empty() {
-                        break;
-                    }
-                }
-                lights.append(&mut file_lights);
-            }
-        }
-        if triangles.len() + unique_triangles > mesh::MAX_TRIANGLES {
-            return fail(
-                m.file.span(),
-                field("file"),
-                format!(
-                    "the scene's meshes hold more than {} triangles",
-                    mesh::MAX_TRIANGLES
-                ),
-            );
-        }
+        Ok(())
     }
-    Ok(Objects {
-        spheres,
-        quads,
-        triangles,
-        instanced,
-        lights,
-        warnings,
+
+    /// The punctual lights of the glTF file `m` names, at each of its `placements`.
+    fn add_gltf_lights(
+        &mut self,
+        m: &MeshToml,
+        placements: &[Mat4],
+        folder: &Path,
+        field: &dyn Fn(&str) -> String,
+    ) -> Result<(), FieldError> {
+        let file = m.file.get_ref();
+        for (p, placement) in placements.iter().enumerate() {
+            let (mut file_lights, file_warnings) =
+                mesh::gltf_lights(&folder.join(file), *placement).or_else(|message| {
+                    fail(m.file.span(), field("file"), format!("{file}: {message}"))
+                })?;
+            // The same warnings for every placement: said once. A file without lights
+            // is not read again for every instance.
+            if p == 0 {
+                self.warnings
+                    .extend(file_warnings.into_iter().map(|w| format!("{file}: {w}")));
+                if file_lights.is_empty() {
+                    break;
+                }
+            }
+            self.lights.append(&mut file_lights);
+        }
+        Ok(())
+    }
+}
+
+/// A mesh's own `translate`, `rotate` (degrees) and `scale` (each factor > 0).
+fn mesh_transform(
+    m: &MeshToml,
+    field: &dyn Fn(&str) -> String,
+) -> Result<MeshTransform, FieldError> {
+    let translate = match &m.translate {
+        Some(t) => coordinates(t, &field("translate"))?,
+        None => Vec3::ZERO,
+    };
+    let rotate = match &m.rotate {
+        Some(r) => vec3(r, &field("rotate"))?,
+        None => Vec3::ZERO,
+    };
+    let scale = match &m.scale {
+        None => Vec3::ONE,
+        Some(s) => {
+            let v = match s.get_ref() {
+                ScaleToml::Uniform(r) => Vec3::splat(r.0 as f32),
+                ScaleToml::PerAxis(a) => Vec3::new(a[0].0 as f32, a[1].0 as f32, a[2].0 as f32),
+            };
+            positive_scale(v, s.span(), &field("scale"))?
+        }
+    };
+    Ok(MeshTransform {
+        scale,
+        rotate_degrees: rotate,
+        translate,
     })
 }
 
