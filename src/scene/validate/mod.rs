@@ -11,10 +11,11 @@ mod objects;
 
 pub(super) use fields::FieldError;
 
-use super::file::SceneToml;
+use super::file::{RenderToml, SceneToml};
 use super::{check_image_size, RenderSettings, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use fields::{fail, int_in, non_negative, radiance_in_range};
 use glam::Vec3;
+use std::ops::Range;
 use std::path::Path;
 
 impl SceneToml {
@@ -48,36 +49,7 @@ impl SceneToml {
 
         let camera = camera::validate_camera(&camera, camera_span, folder)?;
 
-        let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
-        check_image_size(width, height).or_else(|m| {
-            let span = if width < 1 || width > MAX_IMAGE_SIDE as i64 {
-                render.width.span()
-            } else if height < 1 || height > MAX_IMAGE_SIDE as i64 {
-                render.height.span()
-            } else {
-                render_span.clone()
-            };
-            fail(span, "render", m)
-        })?;
-        let spp = int_in(&render.spp, "render.spp", 1, MAX_SPP as i64)?;
-        let max_bounces = int_in(
-            &render.max_bounces,
-            "render.max_bounces",
-            0,
-            MAX_BOUNCES_LIMIT as i64,
-        )?;
-        let background = match &render.background {
-            Some(b) => {
-                let v = non_negative(b, "render.background")?;
-                radiance_in_range(b.span(), "render.background", v.as_dvec3())?;
-                v
-            }
-            None => Vec3::ZERO,
-        };
-        let seed = match &render.seed {
-            Some(s) => int_in(s, "render.seed", 0, u32::MAX as i64)?,
-            None => 0,
-        };
+        let settings = validate_render(&render, render_span)?;
         let mut materials = materials::validate_materials(&self.materials, folder)?;
         let objects = objects::validate_objects(
             &self.spheres,
@@ -104,16 +76,7 @@ impl SceneToml {
         let scene = Scene {
             name,
             camera,
-            render: RenderSettings {
-                width: width as u32,
-                height: height as u32,
-                spp,
-                max_bounces,
-                background,
-                seed,
-                light_sampling: render.light_sampling.unwrap_or(true),
-                russian_roulette: render.russian_roulette.unwrap_or(true),
-            },
+            render: settings,
             materials: materials.list,
             spheres: objects.spheres,
             quads: objects.quads,
@@ -129,4 +92,52 @@ impl SceneToml {
         };
         Ok((scene, warnings))
     }
+}
+
+/// `[render]` (at `render_span` in the file): the image size, samples, bounces, background and
+/// seed, checked in that order.
+fn validate_render(
+    render: &RenderToml,
+    render_span: Range<usize>,
+) -> Result<RenderSettings, FieldError> {
+    let (width, height) = (*render.width.get_ref(), *render.height.get_ref());
+    check_image_size(width, height).or_else(|m| {
+        let span = if width < 1 || width > MAX_IMAGE_SIDE as i64 {
+            render.width.span()
+        } else if height < 1 || height > MAX_IMAGE_SIDE as i64 {
+            render.height.span()
+        } else {
+            render_span.clone()
+        };
+        fail(span, "render", m)
+    })?;
+    let spp = int_in(&render.spp, "render.spp", 1, MAX_SPP as i64)?;
+    let max_bounces = int_in(
+        &render.max_bounces,
+        "render.max_bounces",
+        0,
+        MAX_BOUNCES_LIMIT as i64,
+    )?;
+    let background = match &render.background {
+        Some(b) => {
+            let v = non_negative(b, "render.background")?;
+            radiance_in_range(b.span(), "render.background", v.as_dvec3())?;
+            v
+        }
+        None => Vec3::ZERO,
+    };
+    let seed = match &render.seed {
+        Some(s) => int_in(s, "render.seed", 0, u32::MAX as i64)?,
+        None => 0,
+    };
+    Ok(RenderSettings {
+        width: width as u32,
+        height: height as u32,
+        spp,
+        max_bounces,
+        background,
+        seed,
+        light_sampling: render.light_sampling.unwrap_or(true),
+        russian_roulette: render.russian_roulette.unwrap_or(true),
+    })
 }
