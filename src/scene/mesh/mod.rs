@@ -4,12 +4,14 @@
 //! that are not finite, indices out of range, meshes left with no triangles.
 //!
 //! One file per format (`obj.rs`, `ply.rs`, and glTF's folder `gltf/`, whose `mod.rs` lists its
-//! files); which parts are stored once rather
-//! than copied in `reuse.rs`; this file holds what they share: the parts a file yields, the
-//! material checks, and turning parts into scene triangles and instanced meshes.
+//! files), each yielding the parts in `parts.rs`, its material values passing `checks.rs`;
+//! which parts are stored once rather than copied in `reuse.rs`; this file turns parts into
+//! scene triangles and instanced meshes.
 
+mod checks;
 mod gltf;
 mod obj;
+mod parts;
 mod ply;
 mod reuse;
 mod tangents;
@@ -18,12 +20,15 @@ pub use self::gltf::cameras::{gltf_camera, no_such_camera, FileCamera};
 pub use self::gltf::lights::{gltf_lights, unit, LUMENS_PER_WATT};
 pub use self::gltf::{ExtensionSupport, GLTF_EXTENSIONS};
 
-use super::limits::{MAX_IOR, MAX_NORMAL_SCALE, MAX_RADIANCE, MIN_IOR};
+// What the format readers (obj.rs, ply.rs, gltf/) take from here.
+use checks::{check_emission, check_ior, check_normal_scale, check_reflectance};
+pub(super) use parts::{FileTextures, Geometry, ImageSource, MeshFile, MeshPart};
+
 use super::texture::{Sampling, TextureSet, TextureUse};
 use super::{InstancedMesh, Material, MaterialKind, Triangle};
 use crate::input_file::{read_regular_file, MESH_FILE_LIMIT};
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
-use std::path::{Path, PathBuf};
+use glam::{Mat3, Mat4, Vec3, Vec4};
+use std::path::Path;
 use std::rc::Rc;
 
 /// The most triangles one scene may hold: every BVH reference must fit 30 bits, and far fewer
@@ -86,101 +91,6 @@ impl MeshTransform {
             * Mat4::from_rotation_x(r.x)
             * Mat4::from_scale(self.scale)
     }
-}
-
-/// Triangles with one material, in the file's own coordinates: positions, optional vertex
-/// normals (as many as positions), and triangles as indices into them.
-pub(super) struct Geometry {
-    positions: Vec<Vec3>,
-    normals: Vec<Vec3>,
-    /// Texture coordinates (v up), as many as positions, or none.
-    uvs: Vec<Vec2>,
-    /// glTF's TEXCOORD_1 (v up), as many as positions, or none.
-    uvs1: Vec<Vec2>,
-    /// glTF's TANGENT (xyz along increasing u, w the bitangent's sign), as many as positions,
-    /// or none.
-    tangents: Vec<Vec4>,
-    /// Vertex colours (linear RGBA in [0, 1], glTF's COLOR_0), as many as positions, or none.
-    colors: Vec<Vec4>,
-    indices: Vec<[u32; 3]>,
-}
-
-/// A part of a mesh file: its geometry, placed in the file's space. A glTF mesh used by several
-/// nodes is one geometry shared by several parts, read once.
-pub(super) struct MeshPart {
-    geometry: Rc<Geometry>,
-    /// The file's own placement (a glTF node's world transform), before the scene's.
-    transform: Mat4,
-    /// Index into the file's materials, if the file gives one.
-    material: Option<usize>,
-    /// Where the part came from, for messages (an OBJ object, a glTF node and mesh).
-    name: String,
-}
-
-impl MeshPart {
-    /// A part the file places as it is (OBJ, PLY).
-    fn unplaced(geometry: Geometry, material: Option<usize>, name: String) -> Self {
-        MeshPart {
-            geometry: Rc::new(geometry),
-            transform: Mat4::IDENTITY,
-            material,
-            name,
-        }
-    }
-}
-
-/// What a mesh file holds.
-pub(super) struct MeshFile {
-    parts: Vec<MeshPart>,
-    materials: Vec<Material>,
-    /// Per material: the images of its texture maps.
-    textures: Vec<FileTextures>,
-    /// Whether any material refers to a texture glint does not use (normal maps, ...).
-    has_other_textures: bool,
-    /// Anything else worth a warning line, each a sentence without the file's name.
-    warnings: Vec<String>,
-}
-
-/// Where a texture's image comes from.
-pub(super) enum ImageSource {
-    File(PathBuf),
-    /// An image file's bytes inside the mesh file (a glTF buffer view or `data:` URI), and the
-    /// element that holds them (`images[2]`), for messages.
-    Embedded {
-        element: String,
-        bytes: Rc<[u8]>,
-    },
-}
-
-/// A material's texture maps, as images (shared between the materials that use them).
-#[derive(Default)]
-pub(super) struct FileTextures {
-    /// Multiplies the material's colour (OBJ `map_Kd`, whose colour is then 1; glTF
-    /// `baseColorTexture`).
-    color: Option<(Rc<ImageSource>, Sampling)>,
-    /// glTF's `metallicRoughnessTexture`: green multiplies the roughness, blue the metallic
-    /// factor.
-    metallic_roughness: Option<(Rc<ImageSource>, Sampling)>,
-    /// glTF's `emissiveTexture` (sRGB), multiplying the emission.
-    emission: Option<(Rc<ImageSource>, Sampling)>,
-    /// KHR_materials_transmission's `transmissionTexture` (linear): red multiplies the
-    /// transmission factor.
-    transmission: Option<(Rc<ImageSource>, Sampling)>,
-    /// glTF's `normalTexture` (linear), and its scale.
-    normal: Option<((Rc<ImageSource>, Sampling), f32)>,
-    /// KHR_materials_clearcoat's `clearcoatNormalTexture` (linear), and its scale.
-    clearcoat_normal: Option<((Rc<ImageSource>, Sampling), f32)>,
-    /// OBJ's separate roughness (`map_Pr`) and metallic (`map_Pm`) images, merged on load.
-    roughness_and_metallic: Option<(Option<PathBuf>, Option<PathBuf>)>,
-    /// KHR_materials_clearcoat's clearcoatTexture (red) and clearcoatRoughnessTexture (green).
-    clearcoat: Option<(Rc<ImageSource>, Sampling)>,
-    clearcoat_roughness: Option<(Rc<ImageSource>, Sampling)>,
-    /// KHR_materials_sheen's sheenColorTexture (sRGB) and sheenRoughnessTexture (alpha).
-    sheen_color: Option<(Rc<ImageSource>, Sampling)>,
-    sheen_roughness: Option<(Rc<ImageSource>, Sampling)>,
-    /// OBJ's colour (`map_Kd`, if any) and opacity (`map_d`) images, merged on load into the
-    /// colour texture (the opacity its alpha).
-    color_and_opacity: Option<(Option<PathBuf>, PathBuf)>,
 }
 
 /// The triangles of one `[[meshes]]` entry, ready for the scene.
@@ -624,52 +534,6 @@ fn part_prefix(name: &str) -> String {
     } else {
         format!("{name}: ")
     }
-}
-
-fn check_reflectance(name: &str, what: &str, c: Vec3) -> Result<Vec3, String> {
-    if !c.is_finite() || c.min_element() < 0.0 || c.max_element() > 1.0 {
-        return Err(format!(
-            "material {name:?}: {what} must be in [0, 1], got {c}"
-        ));
-    }
-    Ok(c)
-}
-
-/// An emitted radiance: ≥ 0 and within glint's numeric range, as in scene files.
-fn check_emission(name: &str, what: &str, e: Vec3) -> Result<Vec3, String> {
-    if !e.is_finite() || e.min_element() < 0.0 {
-        return Err(format!("material {name:?}: {what} must be ≥ 0, got {e}"));
-    }
-    if f64::from(e.max_element()) > MAX_RADIANCE {
-        return Err(format!(
-            "material {name:?}: {what} of {:e} is too bright: at most {MAX_RADIANCE:e} per \
-             channel (the numeric range glint supports)",
-            e.max_element()
-        ));
-    }
-    Ok(e)
-}
-
-/// A dielectric's index of refraction within glint's numeric range, as in scene files.
-fn check_ior(name: &str, what: &str, ior: f32) -> Result<f32, String> {
-    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
-        return Err(format!(
-            "material {name:?}: {what} must be in [{MIN_IOR}, {MAX_IOR}] (the numeric range \
-             glint supports), got {ior}"
-        ));
-    }
-    Ok(ior)
-}
-
-/// A normal map's scale within glint's numeric range, as in scene files.
-fn check_normal_scale(material: &str, what: &str, scale: f32) -> Result<f32, String> {
-    if !scale.is_finite() || f64::from(scale.abs()) > MAX_NORMAL_SCALE {
-        return Err(format!(
-            "material {material:?}: {what} must be a number in [-{MAX_NORMAL_SCALE:e}, \
-             {MAX_NORMAL_SCALE:e}] (the numeric range glint supports), got {scale}"
-        ));
-    }
-    Ok(scale)
 }
 
 /// The bytes of a mesh file, if it is a regular file within [`MESH_FILE_LIMIT`].
