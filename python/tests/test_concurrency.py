@@ -82,8 +82,12 @@ def test_the_gil_is_released_while_rendering(cornell):
     assert ticks >= 50, ticks
 
 
+# The child handles SIGINT as an interactive Python does, whatever it inherited: a shell
+# without job control starts background commands with SIGINT ignored, and a Python started
+# so installs no KeyboardInterrupt handler (this test then timed out under `scripts/test &`).
 CHILD = r"""
-import json, sys, numpy as np, glint
+import json, signal, sys, numpy as np, glint
+signal.signal(signal.SIGINT, signal.default_int_handler)
 scene = glint.load(sys.argv[1])
 print("rendering", flush=True)
 result = glint.render(scene, width=64, height=64, spp=1_000_000, device="cpu", full=True)
