@@ -2,7 +2,7 @@
 //! reads onto it, its alpha, and which images its texture maps sample, each value checked
 //! (the geometry is read in `primitives.rs`).
 
-use super::texture_ref::TextureRefs;
+use super::texture_ref::{NormalImage, TextureRefs};
 use crate::scene::mesh::{check_emission, check_ior, check_reflectance};
 use crate::scene::texture::Sampling;
 use crate::scene::{Alpha, AlphaMode, Material, MaterialKind, PbrLayers};
@@ -431,9 +431,6 @@ fn alpha(m: &json::Material, index: usize) -> Result<Alpha, String> {
     };
     Ok(Alpha { mode, opacity })
 }
-
-/// A normal map's image (an index into `images`), how it is sampled, and its scale.
-pub(super) type NormalImage = ((usize, Sampling), f32);
 
 /// The images (indices into `images`) of a material's texture maps, and how each is sampled.
 pub(super) struct MaterialImages {

@@ -3,13 +3,15 @@
 //! KHR_texture_transform, each checked.
 
 use super::document::exists;
-use super::material::NormalImage;
 use crate::kernel::types::{TEXTURE_WRAP_CLAMP, TEXTURE_WRAP_MIRROR, TEXTURE_WRAP_REPEAT};
 use crate::scene::mesh::check_normal_scale;
 use crate::scene::texture::Sampling;
 use gltf::json;
 use json::texture::{MagFilter, WrappingMode};
 use json::validation::Checked;
+
+/// A normal map's image (an index into `images`), how it is sampled, and its scale.
+pub(super) type NormalImage = ((usize, Sampling), f32);
 
 /// What reading one material's texture references takes: the document, the material's index
 /// (which messages name) and where warnings about the references glint ignores go.

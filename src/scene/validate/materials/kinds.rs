@@ -2,9 +2,9 @@
 //! dielectric; `pbr` in `pbr.rs`), and which fields each kind takes.
 
 use super::super::fields::{fail, real, FieldError};
+use super::ior_in_range;
 use super::pbr::pbr_kind;
-use crate::scene::file::{MaterialToml, Real, RoughnessToml, S};
-use crate::scene::limits::{MAX_IOR, MIN_IOR};
+use crate::scene::file::{MaterialToml, RoughnessToml, S};
 use crate::scene::texture::TextureSet;
 use crate::scene::MaterialKind;
 use std::path::Path;
@@ -80,22 +80,6 @@ fn required<'a, T>(
             format!("missing: a {what} needs {name}"),
         ),
     }
-}
-
-/// An index of refraction (`ior`) within the range glint supports.
-pub(super) fn ior_in_range(x: &S<Real>, field: &dyn Fn(&str) -> String) -> Result<f32, FieldError> {
-    let ior = real(x, &field("ior"))?;
-    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
-        return fail(
-            x.span(),
-            field("ior"),
-            format!(
-                "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
-                 numeric range glint supports), got {ior}"
-            ),
-        );
-    }
-    Ok(ior)
 }
 
 /// A field that does not apply to the material's kind is most likely a mistake: say so.

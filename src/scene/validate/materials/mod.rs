@@ -10,6 +10,7 @@ mod pbr;
 
 use super::fields::{fail, non_negative, radiance_in_range, real, FieldError};
 use crate::scene::file::{MaterialToml, Real, RoughnessToml, Triple, S};
+use crate::scene::limits::{MAX_IOR, MIN_IOR};
 use crate::scene::texture::{TextureSet, TextureUse};
 use crate::scene::{Material, MaterialKind};
 use glam::Vec3;
@@ -223,4 +224,20 @@ fn unit_interval(x: &S<Real>, field: &str) -> Result<f32, FieldError> {
         return fail(x.span(), field, format!("must be in [0, 1], got {v}"));
     }
     Ok(v)
+}
+
+/// An index of refraction (`ior`) within the range glint supports.
+pub(super) fn ior_in_range(x: &S<Real>, field: &dyn Fn(&str) -> String) -> Result<f32, FieldError> {
+    let ior = real(x, &field("ior"))?;
+    if !(MIN_IOR..=MAX_IOR).contains(&ior) {
+        return fail(
+            x.span(),
+            field("ior"),
+            format!(
+                "the index of refraction must be in [{MIN_IOR}, {MAX_IOR}] (the \
+                 numeric range glint supports), got {ior}"
+            ),
+        );
+    }
+    Ok(ior)
 }

@@ -4,9 +4,8 @@
 //! layers, then metallic, ior, specular and transmission.
 
 use super::super::fields::{fail, non_negative, real, FieldError};
-use super::kinds::ior_in_range;
 use super::maps::{normal_map, texture};
-use super::{reflectance, unit_interval};
+use super::{ior_in_range, reflectance, unit_interval};
 use crate::scene::file::{MaterialToml, Real, RoughnessToml, S};
 use crate::scene::texture::{TextureSet, TextureUse};
 use crate::scene::{MaterialKind, PbrLayers};
