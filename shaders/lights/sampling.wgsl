@@ -12,7 +12,7 @@ struct EmitterChoice {
     probability: f32,
 }
 
-// Selection in proportion to power, in O(1) by the alias table (src/kernel/scene.rs): u picks
+// Selection in proportion to power, in O(1) by the alias table (src/kernel/scene/emitter_table.rs): u picks
 // the slot, u_alias its emitter or the alias. The slot is floor(u * n) in f32 on both devices
 // (a correctly rounded product, then truncation), so both pick the same emitter.
 fn pick_emitter(u: f32, u_alias: f32) -> EmitterChoice {

@@ -1,5 +1,5 @@
 //! The mean radiance a triangle with an emission texture (glTF's emissiveTexture) emits, for
-//! light sampling's choice of emitter by power (`kernel::scene`).
+//! light sampling's choice of emitter by power (`kernel::scene::emitter_table`).
 //!
 //! The mean is over the texels the triangle's lookups can read: every lookup at a point of the
 //! triangle blends texels inside the box its three texture coordinates span (mapped through the

@@ -284,7 +284,7 @@ pub const PRIMITIVE_INSTANCE: u32 = 3;
 /// instance): its arrays hold it in the scene's coordinates.
 pub const NO_INSTANCE: u32 = u32::MAX;
 
-/// A placement of an instanced mesh (`src/kernel/scene.rs` lays them out, `shaders/geometry/instance.wgsl`
+/// A placement of an instanced mesh (`src/kernel/scene/acceleration.rs` lays them out, `shaders/geometry/instance.wgsl`
 /// reads them): its transforms as the rows of 3×4 matrices (a point p goes to
 /// `(row · (p, 1))` per row), and its mesh's bottom-level BVH, whose root is
 /// `bvh_nodes[blas_root]` and whose leaves reference the mesh's triangles, stored once in the

@@ -69,7 +69,7 @@ impl Light {
     }
 
     /// Power over π (the π every emitter's power shares is dropped, as in
-    /// `src/kernel/scene.rs`), channels averaged; `scene_radius` sizes a sun's disc of light.
+    /// `src/kernel/scene/emitter_table.rs`), channels averaged; `scene_radius` sizes a sun's disc of light.
     /// A point light radiates 4πI; a spot 2πI·((1 − cos inner) + (cos inner − cos outer)/2),
     /// as pbrt-v4 counts it; a sun E·πR² through the scene's disc, as the environment map does.
     pub fn power(&self, scene_radius: f64) -> f64 {

@@ -89,7 +89,7 @@ pub struct Scene {
 }
 
 /// A mesh placed many times and stored once: the two-level structure's bottom level
-/// (src/kernel/scene.rs lays it out, shaders/traverse/blas.wgsl traces it). Its triangles are
+/// (src/kernel/scene/acceleration.rs lays it out, shaders/traverse/blas.wgsl traces it). Its triangles are
 /// in the mesh file's own coordinates (a glTF primitive's, before its node's transform), and
 /// each placement takes them to the scene's. Only opaque meshes that do not emit and have no
 /// normal map are held so ([`Material::two_level`] says why, `mesh/reuse.rs` which parts);
@@ -295,7 +295,7 @@ impl Material {
     /// Whether a mesh in this material may be stored once and placed by transforms (the
     /// two-level structure, [`InstancedMesh`]), rather than copied per placement. Not when it
     /// emits: light sampling picks emitting triangles by their power in the scene's
-    /// coordinates, one table entry per placed triangle (src/kernel/scene.rs), which an
+    /// coordinates, one table entry per placed triangle (src/kernel/scene/emitter_table.rs), which an
     /// instance would have to sample through its transform. Not when alpha-tested or blended,
     /// nor with a normal map: the alpha test and the tangent frame would need the instance
     /// too. Those are copied as before, which is exact.

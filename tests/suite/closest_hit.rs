@@ -68,7 +68,7 @@ fn copies_scene(dir: &std::path::Path) -> KernelScene {
 }
 
 /// [`copies_scene`]'s file, its cube's copies flattened (`[[meshes]]` entries) or, without
-/// `flattened`, one entry's 20 coincident instances in white (stored once, src/kernel/scene.rs).
+/// `flattened`, one entry's 20 coincident instances in white (stored once, src/kernel/scene/acceleration.rs).
 fn copies_toml(dir: &std::path::Path, flattened: bool) -> String {
     std::fs::write(dir.join("cube.obj"), CUBE_OBJ).unwrap();
     StressMesh::new(24, 12)

@@ -1,7 +1,7 @@
 //! `[[meshes]] instances`: a mesh file placed many times. An entry with two or more instances
 //! whose materials neither emit, nor are alpha-tested or blended, nor map normals is stored
 //! once, in its own coordinates, and traced through the two-level structure (one BVH per
-//! mesh, instances as leaves of the scene's BVH: src/kernel/scene.rs, shaders/traverse/blas.wgsl);
+//! mesh, instances as leaves of the scene's BVH: src/kernel/scene/acceleration.rs, shaders/traverse/blas.wgsl);
 //! other entries are flattened into the scene's triangles as before (`load_placed`). The
 //! two-level scene renders the flattened one's image (the same paths, up to the rounding of
 //! testing rays in each instance's coordinates) on both devices, finds the brute-force scan's

@@ -1,6 +1,6 @@
 //! Instances (WGSL side: `shaders/geometry/instance.wgsl`). A mesh placed many times keeps its
 //! triangles once, in its own coordinates, and each placement keeps its transforms
-//! (`src/kernel/scene.rs`), so memory grows with unique geometry. A hit through an instance
+//! (`src/kernel/scene/acceleration.rs`), so memory grows with unique geometry. A hit through an instance
 //! carries (instance, triangle); what shading reads of the triangle is put in the scene's
 //! coordinates here, so the code after intersection is the same for every triangle. Triangles
 //! placed as they are ([`NO_INSTANCE`]) are read unchanged, without arithmetic.

@@ -110,7 +110,7 @@ pub(super) fn plan(
 }
 
 /// Whether the kernel can take rays into the coordinates `m` places (its inverse, computed in
-/// f64 as src/kernel/scene.rs does, is finite in f32).
+/// f64 as src/kernel/scene/ does, is finite in f32).
 fn invertible(m: &Mat4) -> bool {
     let m = m.as_dmat4();
     m.determinant() != 0.0 && m.inverse().as_mat4().is_finite()

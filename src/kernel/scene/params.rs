@@ -1,0 +1,87 @@
+//! The kernel's `Params`: the render settings, the arrays' counts, the environment map's
+//! size and rotation, and the camera.
+
+use crate::kernel::types::{
+    Emitter, Params, PRIMITIVE_ENVIRONMENT, PROJECTION_ORTHOGRAPHIC, PROJECTION_PERSPECTIVE,
+    ROULETTE_OFF,
+};
+use crate::scene::environment::Environment;
+use crate::scene::{Camera, CameraBasis, Projection, Scene, ROULETTE_START_BOUNCE};
+
+/// Writes `camera` into `params` for its image size (`params.width`, `params.height`): the
+/// basis precomputed, image-right and image-up scaled to half the viewport at unit distance
+/// (perspective) or to half the view in world units (orthographic), and the lens. Apart from
+/// the rest so the viewer can move the camera without rebuilding the scene's arrays (the BVH,
+/// the environment map's tables).
+pub fn place_camera(params: &mut Params, camera: &Camera) {
+    let CameraBasis {
+        w,
+        right: u,
+        image_up: v,
+    } = camera.basis();
+    let (projection, half_height) = match camera.projection {
+        Projection::Perspective { vfov } => {
+            (PROJECTION_PERSPECTIVE, (vfov.to_radians() * 0.5).tan())
+        }
+        Projection::Orthographic { height } => (PROJECTION_ORTHOGRAPHIC, 0.5 * height),
+    };
+    params.projection = projection;
+    let half_width = half_height * params.width as f32 / params.height as f32;
+    let lens_radius = 0.5 * camera.aperture;
+    params.eye = camera.eye.into();
+    params.forward = (-w).into();
+    params.right = (u * half_width).into();
+    params.up = (v * half_height).into();
+    params.lens_right = (u * lens_radius).into();
+    params.lens_up = (v * lens_radius).into();
+    params.focus_distance = camera.focus_distance;
+}
+
+impl Scene {
+    /// The scene's `Params`, given its `emitters` (light sampling's table) and `environment`
+    /// map; no samples yet, no AOVs nor clamp (the render's own settings set those).
+    pub(super) fn kernel_params(
+        &self,
+        emitters: &[Emitter],
+        environment: Option<&Environment>,
+    ) -> Params {
+        let r = &self.render;
+        let (environment_cos, environment_sin) = environment.map_or((1.0, 0.0), |e| e.rotation());
+        let mut params = Params {
+            width: r.width,
+            height: r.height,
+            sample_start: 0,
+            sample_count: 0,
+            background: r.background.into(),
+            max_bounces: r.max_bounces,
+            light_sampling: r.light_sampling as u32,
+            seed: r.seed,
+            sphere_count: self.spheres.len() as u32,
+            quad_count: self.quads.len() as u32,
+            material_count: self.materials.len() as u32,
+            emitter_count: emitters.len() as u32,
+            roulette_start: if r.russian_roulette {
+                ROULETTE_START_BOUNCE
+            } else {
+                ROULETTE_OFF
+            },
+            accumulated_samples: 0,
+            aovs: 0,
+            radiance_clamp: 0.0,
+            // The scan's: the triangles placed as they are (instanced ones follow them).
+            triangle_count: self.triangles.len() as u32,
+            environment_width: environment.map_or(0, |e| e.image.width),
+            environment_height: environment.map_or(0, |e| e.image.height),
+            environment_cos,
+            environment_sin,
+            environment_light_probability: emitters
+                .iter()
+                .find(|e| e.primitive == PRIMITIVE_ENVIRONMENT)
+                .map_or(0.0, |e| e.probability),
+            light_count: self.lights.len() as u32,
+            ..Default::default()
+        };
+        place_camera(&mut params, &self.camera);
+        params
+    }
+}
