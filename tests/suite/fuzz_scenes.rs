@@ -232,6 +232,11 @@ fn random_number(rng: &mut Rng) -> String {
 
 fn mutate_once(text: &str, rng: &mut Rng) -> String {
     let lines: Vec<&str> = text.lines().collect();
+    // A scene mutated down to nothing has no line to remove, copy or swap (that panicked here,
+    // for a seed that reached it): only inserting can go on from there.
+    if lines.is_empty() {
+        return format!("{}{text}", rng.pick(BYTES));
+    }
     let line = rng.below(lines.len());
     let with_lines = |lines: Vec<&str>| lines.join("\n") + "\n";
     match rng.below(11) {
