@@ -284,6 +284,27 @@ pub struct Material {
 }
 
 impl Material {
+    /// A material without texture maps; the mesh readers add theirs once they have read them.
+    pub fn untextured(
+        name: String,
+        kind: MaterialKind,
+        color: Vec3,
+        emitted_radiance: Vec3,
+        alpha: Alpha,
+    ) -> Material {
+        Material {
+            name,
+            kind,
+            color,
+            emitted_radiance,
+            color_texture: None,
+            roughness_texture: None,
+            emission_texture: None,
+            normal_texture: None,
+            alpha,
+        }
+    }
+
     /// Whether the material has a normal map (its own, or its coat's), which needs vertex
     /// tangents.
     pub fn has_normal_map(&self) -> bool {

@@ -249,17 +249,13 @@ fn strip_prefix(message: &str, shown: &str) -> String {
 }
 
 fn default_material_value() -> Material {
-    Material {
-        name: DEFAULT_MATERIAL.into(),
-        kind: MaterialKind::Diffuse,
-        color: Vec3::splat(DEFAULT_COLOR),
-        emitted_radiance: Vec3::ZERO,
-        color_texture: None,
-        roughness_texture: None,
-        emission_texture: None,
-        normal_texture: None,
-        alpha: super::Alpha::OPAQUE,
-    }
+    Material::untextured(
+        DEFAULT_MATERIAL.into(),
+        MaterialKind::Diffuse,
+        Vec3::splat(DEFAULT_COLOR),
+        Vec3::ZERO,
+        super::Alpha::OPAQUE,
+    )
 }
 
 /// The environment `--environment` names, or the studio map.

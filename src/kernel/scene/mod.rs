@@ -123,17 +123,13 @@ impl Scene {
                 radius,
                 material: scene.materials.len() as u32,
             });
-            scene.materials.push(crate::scene::Material {
-                name: format!("lights[{i}]"),
-                kind: MaterialKind::Diffuse,
-                color: Vec3::ZERO,
-                emitted_radiance: radiance,
-                color_texture: None,
-                roughness_texture: None,
-                emission_texture: None,
-                normal_texture: None,
-                alpha: crate::scene::Alpha::OPAQUE,
-            });
+            scene.materials.push(crate::scene::Material::untextured(
+                format!("lights[{i}]"),
+                MaterialKind::Diffuse,
+                Vec3::ZERO,
+                radiance,
+                crate::scene::Alpha::OPAQUE,
+            ));
         }
         scene
     }

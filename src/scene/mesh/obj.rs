@@ -90,24 +90,15 @@ fn obj_material(
         }
         _ => check_reflectance(name, "Kd", kd)?,
     };
-    let mut material = Material {
-        name: name.clone(),
-        kind,
-        color,
-        emitted_radiance: emission,
-        color_texture: None,
-        roughness_texture: None,
-        emission_texture: None,
-        normal_texture: None,
-        alpha: if opacity < 1.0 {
-            Alpha {
-                mode: AlphaMode::Blend,
-                opacity,
-            }
-        } else {
-            Alpha::OPAQUE
-        },
+    let alpha = if opacity < 1.0 {
+        Alpha {
+            mode: AlphaMode::Blend,
+            opacity,
+        }
+    } else {
+        Alpha::OPAQUE
     };
+    let mut material = Material::untextured(name.clone(), kind, color, emission, alpha);
     let (maps, other_textures) = mtl.texture_maps(&mut material, map_ke)?;
     let other_textures = other_textures | mtl.has_unread_textures();
     Ok((material, maps, other_textures, warnings))

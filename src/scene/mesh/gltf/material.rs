@@ -93,17 +93,7 @@ pub(super) fn material(
         return Ok((material, maps, other_textures));
     }
     Ok((
-        Material {
-            name,
-            kind,
-            color,
-            emitted_radiance: emission,
-            color_texture: None,
-            roughness_texture: None,
-            emission_texture: None,
-            normal_texture: None,
-            alpha,
-        },
+        Material::untextured(name, kind, color, emission, alpha),
         maps,
         other_textures,
     ))
@@ -288,17 +278,7 @@ fn unlit(
     maps: MaterialImages,
 ) -> (Material, MaterialImages) {
     (
-        Material {
-            name,
-            kind: MaterialKind::Unlit,
-            color: Vec3::ZERO,
-            emitted_radiance: color,
-            color_texture: None,
-            roughness_texture: None,
-            emission_texture: None,
-            normal_texture: None,
-            alpha,
-        },
+        Material::untextured(name, MaterialKind::Unlit, Vec3::ZERO, color, alpha),
         MaterialImages {
             // The colour texture stays for its alpha (× black, it adds no colour).
             emission: maps.color,
