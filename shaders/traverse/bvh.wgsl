@@ -4,104 +4,94 @@
 // first, and popped nodes skipped when they start beyond the closest hit so far. Shadow rays
 // stop at the first primitive in front of the one they aim at. Which hit is the closest, and
 // which primitives are in front, is the closest-hit rule's (hit_comes_first), whatever the
-// order of visits. The tests the walks share are in bvh_ray.wgsl.
+// order of visits. The walk itself is binary_walk.wgsl's, the tests the walks share are in
+// bvh_ray.wgsl.
+
+// What a search of the scene's primitives has found so far: the walks of the binary tree
+// (bvh_traverse) and of the wide one (wide.wgsl) share it and their leaves' visit.
+struct PrimitiveSearch {
+    best: ClosestPrimitive,
+    // The top-level reference of the best hit, for the closest-hit rule's ties.
+    best_reference: u32,
+    // How far the walk still looks: boxes entered beyond it are skipped.
+    prune: f32,
+    found: bool,
+}
+
+fn primitive_search(t_max: f32, t_prune: f32, max_reference: u32) -> PrimitiveSearch {
+    return PrimitiveSearch(ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u, NO_INSTANCE), max_reference, t_prune, false);
+}
+
+// The search's result: its best hit, or t = NO_HIT when it found none.
+fn search_result(search: PrimitiveSearch) -> ClosestPrimitive {
+    var best = search.best;
+    if !search.found {
+        best.t = NO_HIT;
+    }
+    return best;
+}
+
+// Tests a leaf's primitives, bvh_primitives[first .. first + count], whose box the ray enters
+// at node_entry. True when the search is over: a shadow ray found something in front of its
+// target.
+fn visit_scene_leaf(search: ptr<function, PrimitiveSearch>, first: u32, count: u32, node_entry: f32, r: BvhRay, shadow_target: u32) -> bool {
+    for (var i = 0u; i < count; i++) {
+        let reference = bvh_primitives[first + i];
+        if HAS_INSTANCES && (reference >> PRIMITIVE_KIND_SHIFT) == PRIMITIVE_INSTANCE {
+            // Its closest triangle that comes before the best so far: at the same t
+            // only if this reference is the lower (the rule, extended by triangle).
+            let instance = reference & PRIMITIVE_INDEX_MASK;
+            let h = hit_instance(instance, r.ray, (*search).best.t, reference < (*search).best_reference, (*search).prune, shadow_target != NO_PRIMITIVE);
+            if h.t != NO_HIT {
+                (*search).best = ClosestPrimitive(h.t, PRIMITIVE_TRIANGLE, h.triangle, instance);
+                (*search).best_reference = reference;
+                (*search).prune = max(h.prune, node_entry);
+                (*search).found = true;
+                if shadow_target != NO_PRIMITIVE {
+                    return true;
+                }
+            }
+            continue;
+        }
+        let t = hit_primitive(reference, r);
+        // The target is excluded by name too, not only by the rule: the compiler may
+        // round its test here and in bvh_first_hit_is differently.
+        if hit_comes_first(t, reference, (*search).best.t, (*search).best_reference) && reference != shadow_target {
+            (*search).best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK, NO_INSTANCE);
+            (*search).best_reference = reference;
+            (*search).prune = max(t, node_entry);
+            (*search).found = true;
+            if shadow_target != NO_PRIMITIVE {
+                return true;
+            }
+        }
+    }
+    return false;
+}
 
 fn bvh_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
     // The wide tree in the wide variant (the GPU's layout: src/kernel/bvh/layout.rs).
     if BVH_WIDE {
         return wide_traverse(r, t_max, t_prune, max_reference, shadow_target);
     }
-    var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
-    var best_reference = max_reference;
-    var prune = t_prune;
-    var found = false;
-    // Node indices only: a popped node's entry distance is recomputed (the same arithmetic,
-    // so the same decision), which halves the per-lane stack lavapipe keeps in memory.
-    var stack: array<u32, BVH_STACK_SIZE>;
-    var top = 0u;
-    var node_index = 0u;
-    // Where the ray enters the node being entered.
-    var node_entry = hit_box(bvh_node(0u), r, prune);
-    if node_entry == NO_HIT {
-        return ClosestPrimitive(NO_HIT, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
-    }
-    loop {
-        let node = bvh_node(node_index);
-        if node.count > 0u {
-            for (var i = 0u; i < node.count; i++) {
-                let reference = bvh_primitives[node.first + i];
-                if HAS_INSTANCES && (reference >> PRIMITIVE_KIND_SHIFT) == PRIMITIVE_INSTANCE {
-                    // Its closest triangle that comes before the best so far: at the same t
-                    // only if this reference is the lower (the rule, extended by triangle).
-                    let instance = reference & PRIMITIVE_INDEX_MASK;
-                    let h = hit_instance(instance, r.ray, best.t, reference < best_reference, prune, shadow_target != NO_PRIMITIVE);
-                    if h.t != NO_HIT {
-                        best = ClosestPrimitive(h.t, PRIMITIVE_TRIANGLE, h.triangle, instance);
-                        best_reference = reference;
-                        prune = max(h.prune, node_entry);
-                        found = true;
-                        if shadow_target != NO_PRIMITIVE {
-                            return best;
-                        }
-                    }
-                    continue;
+    var search = primitive_search(t_max, t_prune, max_reference);
+    var walk: BinaryWalk;
+    if binary_walk_start(&walk, 0u, r, search.prune) {
+        loop {
+            let node = bvh_node(walk.node_index);
+            if node.count > 0u {
+                if visit_scene_leaf(&search, node.first, node.count, walk.node_entry, r, shadow_target) {
+                    return search.best;
                 }
-                let t = hit_primitive(reference, r);
-                // The target is excluded by name too, not only by the rule: the compiler may
-                // round its test here and in bvh_first_hit_is differently.
-                if hit_comes_first(t, reference, best.t, best_reference) && reference != shadow_target {
-                    best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK, NO_INSTANCE);
-                    best_reference = reference;
-                    prune = max(t, node_entry);
-                    found = true;
-                    if shadow_target != NO_PRIMITIVE {
-                        return best;
-                    }
-                }
-            }
-        } else {
-            let left = node.first;
-            let t_left = hit_box(bvh_node(left), r, prune);
-            let t_right = hit_box(bvh_node(left + 1u), r, prune);
-            if t_left != NO_HIT && t_right != NO_HIT {
-                let left_first = t_left <= t_right;
-                stack[top] = select(left, left + 1u, left_first);
-                top += 1u;
-                node_index = select(left + 1u, left, left_first);
-                node_entry = min(t_left, t_right);
+            } else if binary_walk_descend(&walk, node, r, search.prune) {
                 continue;
             }
-            if t_left != NO_HIT {
-                node_index = left;
-                node_entry = t_left;
-                continue;
-            }
-            if t_right != NO_HIT {
-                node_index = left + 1u;
-                node_entry = t_right;
-                continue;
-            }
-        }
-        // Pop the next node that may still hold something before the best hit.
-        var popped = false;
-        while top > 0u {
-            top -= 1u;
-            let entry = hit_box(bvh_node(stack[top]), r, prune);
-            if entry != NO_HIT {
-                node_index = stack[top];
-                node_entry = entry;
-                popped = true;
+            if !binary_walk_pop(&walk, r, search.prune) {
                 break;
             }
         }
-        if !popped {
-            break;
-        }
     }
-    if !found {
-        best.t = NO_HIT;
-    }
-    return best;
+    return search_result(search);
 }
 
 fn bvh_closest_primitive(ray: Ray) -> ClosestPrimitive {

@@ -1,6 +1,6 @@
 // What the BVH walks share (mirror: src/cpu/traverse/bvh_ray.rs): the ray with its reciprocal
 // direction, the box test and its rounding slack, and the leaves' primitive tests. The walks
-// themselves are bvh.wgsl, blas.wgsl and wide.wgsl.
+// themselves are binary_walk.wgsl (for bvh.wgsl and blas.wgsl) and wide.wgsl.
 
 // The closest primitive through the BVH that comes before the bound (t_max, max_reference) by
 // the closest-hit rule (hit_comes_first); a closest-hit search passes (NO_HIT, 0), which no

@@ -7,7 +7,7 @@ use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 41] = [
+pub const SHADER_PARTS: [(&str, &str); 42] = [
     (
         "core/types.wgsl",
         include_str!("../../shaders/core/types.wgsl"),
@@ -40,6 +40,10 @@ pub const SHADER_PARTS: [(&str, &str); 41] = [
     (
         "traverse/bvh_ray.wgsl",
         include_str!("../../shaders/traverse/bvh_ray.wgsl"),
+    ),
+    (
+        "traverse/binary_walk.wgsl",
+        include_str!("../../shaders/traverse/binary_walk.wgsl"),
     ),
     (
         "traverse/bvh.wgsl",

@@ -1,8 +1,9 @@
 //! The walk of a binary BVH that both levels of the two-level structure take: the top level
 //! (`bvh.rs`) and an instance's own BVH (`blas.rs`). A fixed stack, the nearer child first,
 //! and popped nodes skipped when they start beyond the bound. What a leaf does is the caller's.
-//! The kernel has no closures, so `shaders/traverse/bvh.wgsl` and `shaders/traverse/blas.wgsl`
-//! each write this walk out; their decisions are this one's.
+//! The kernel has no closures, so `shaders/traverse/binary_walk.wgsl` gives its callers the
+//! walk's steps (start, descend, pop) and each keeps its leaf's visit in its own loop; their
+//! decisions are this one's.
 
 use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::traverse::bvh_ray::{hit_box, widened, BvhRay};
