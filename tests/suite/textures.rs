@@ -209,6 +209,34 @@ fn srgb_textures_are_linearised_and_data_textures_are_not() {
     }
 }
 
+/// A colour texture is filtered after its sRGB decoding, as glTF asks ("the transfer function
+/// should be decoded before performing linear interpolation"; Khronos' sample
+/// TextureLinearInterpolationTest): halfway between a black and a white texel reads 0.5, not
+/// the decoded midpoint byte (0.2140). Blender's Cycles interpolates 8-bit sRGB images before
+/// decoding them, which darkens a checker's edges (docs/src/performance/validation.md).
+#[test]
+fn colour_textures_are_filtered_after_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("bw.png"), 2, 1, |x, _| [255 * x as u8; 3]);
+    let material = "type = \"diffuse\"\ncolor = { texture = \"bw.png\" }";
+    let scene = scene_with(dir.path(), material, 4).unwrap().kernel_scene();
+    let m = &scene.materials[0];
+    // Texel centres at u = 0.25 and 0.75; u = 0.5 is halfway, u = 0.375 a quarter of the way.
+    let uvs = [Vec2::new(0.5, 0.5), Vec2::new(0.375, 0.5)];
+    for (device, values) in lookups(&scene, m.color_texture, &uvs) {
+        assert!(
+            (values[0] - Vec3::splat(0.5)).abs().max_element() < 1e-6,
+            "{device}: {}",
+            values[0]
+        );
+        assert!(
+            (values[1] - Vec3::splat(0.25)).abs().max_element() < 1e-6,
+            "{device}: {}",
+            values[1]
+        );
+    }
+}
+
 /// The same file used twice for colour is loaded once.
 #[test]
 fn a_file_used_twice_is_loaded_once() {
