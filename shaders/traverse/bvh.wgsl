@@ -7,8 +7,7 @@
 // order of visits. The walk itself is binary_walk.wgsl's, the tests the walks share are in
 // bvh_ray.wgsl.
 
-// What a search of the scene's primitives has found so far: the walks of the binary tree
-// (bvh_traverse) and of the wide one (wide.wgsl) share it and their leaves' visit.
+// What a search of the scene's primitives has found so far.
 struct PrimitiveSearch {
     best: ClosestPrimitive,
     // The top-level reference of the best hit, for the closest-hit rule's ties.

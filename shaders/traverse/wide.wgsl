@@ -65,7 +65,10 @@ fn farthest_first(t: vec4<f32>) -> vec4<u32> {
 const WIDE_LEAF: u32 = 0x80000000u;
 
 fn wide_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow_target: u32) -> ClosestPrimitive {
-    var search = primitive_search(t_max, t_prune, max_reference);
+    var best = ClosestPrimitive(t_max, PRIMITIVE_QUAD, 0u, NO_INSTANCE);
+    var best_reference = max_reference;
+    var prune = t_prune;
+    var found = false;
     // Children left for later, and where the ray enters their box. The root is entered from
     // 0: its children's boxes are tested instead.
     var stack: array<u32, BVH_WIDE_STACK_SIZE>;
@@ -76,13 +79,13 @@ fn wide_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow
     while top > 0u {
         top -= 1u;
         let node_entry = stack_entry[top];
-        if node_entry > widened(search.prune) {
+        if node_entry > widened(prune) {
             continue;
         }
         let item = stack[top];
         if (item & WIDE_LEAF) == 0u {
             let node = bvh_wide_node(item);
-            let t = hit_wide_boxes(node, r, search.prune);
+            let t = hit_wide_boxes(node, r, prune);
             let order = farthest_first(t);
             for (var k = 0u; k < 4u; k++) {
                 let slot = order[k];
@@ -95,9 +98,23 @@ fn wide_traverse(r: BvhRay, t_max: f32, t_prune: f32, max_reference: u32, shadow
             continue;
         }
         let leaf = bvh_wide_leaf((item & ~WIDE_LEAF) >> 2u, item & 3u);
-        if visit_scene_leaf(&search, leaf.x, leaf.y, node_entry, r, shadow_target) {
-            return search.best;
+        for (var i = leaf.x; i < leaf.x + leaf.y; i++) {
+            let reference = bvh_primitives[i];
+            let t = hit_primitive(reference, r);
+            // The target is excluded by name too, as in bvh_traverse.
+            if hit_comes_first(t, reference, best.t, best_reference) && reference != shadow_target {
+                best = ClosestPrimitive(t, reference >> PRIMITIVE_KIND_SHIFT, reference & PRIMITIVE_INDEX_MASK, NO_INSTANCE);
+                best_reference = reference;
+                prune = max(t, node_entry);
+                found = true;
+                if shadow_target != NO_PRIMITIVE {
+                    return best;
+                }
+            }
         }
     }
-    return search_result(search);
+    if !found {
+        best.t = NO_HIT;
+    }
+    return best;
 }
