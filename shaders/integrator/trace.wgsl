@@ -179,7 +179,14 @@ fn add_unblocked_light(
         // key, so both see the same blended triangles.
         alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
     }
-    if light_visible(Ray(origin, light.dir), light) {
+    // A light behind a rough transmissive surface (bsdf_eval passes it only there) is reached
+    // through the surface itself: the shadow ray starts on its far side, so that this surface
+    // does not block it while every other one (a closed object's far wall) still does.
+    var shadow_origin = origin;
+    if dot(light.dir, hit.normal) < 0.0 {
+        shadow_origin = offset_ray_origin(hit.position, hit.error, -hit.normal);
+    }
+    if light_visible(Ray(shadow_origin, light.dir), light) {
         let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
         let weight = nee_weight(light, pdf);
         let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);

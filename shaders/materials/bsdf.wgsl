@@ -6,7 +6,7 @@ struct BsdfSample {
     weight: vec3<f32>,
     // Solid-angle pdf of dir; 0 for delta lobes.
     pdf: f32,
-    // Light sampling cannot find dir, so what the ray reaches counts in full: delta lobes, and
-    // refraction (shadow rays do not pass through surfaces).
+    // Light sampling cannot find dir, so what the ray reaches counts in full: delta lobes,
+    // smooth refraction among them (material.wgsl's transmits_roughly says which is rough).
     is_delta: bool,
 }

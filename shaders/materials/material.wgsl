@@ -22,13 +22,21 @@ fn is_delta(m: Material) -> bool {
         || (is_metal(m) && m.alpha < MIN_METAL_ALPHA);
 }
 
+// Whether light sampling may evaluate the material below its surface: a pbr material with a
+// rough transmission lobe (pbr.wgsl's pbr_refraction_is_delta says when it is not rough).
+fn transmits_roughly(m: Material) -> bool {
+    return HAS_TRANSMISSION && is_pbr(m) && m.transmission > 0.0 && m.metallic < 1.0
+        && !pbr_refraction_is_delta(m);
+}
+
 // f * cos(theta_i) for light arriving from wi and leaving towards wo (n faces wo; front_face says
-// whether that is the outside). Zero for delta lobes and for wi below the surface (light
-// sampling's shadow rays do not pass through surfaces). coat_n, facing wo too, is the pbr
-// coat's own shading normal (KHR_materials_clearcoat's: n itself where nothing tilts it).
+// whether that is the outside). Zero for delta lobes, and for wi below the surface except
+// through a rough transmission lobe (transmits_roughly), whose light samples' shadow rays leave
+// through the surface. coat_n, facing wo too, is the pbr coat's own shading normal
+// (KHR_materials_clearcoat's: n itself where nothing tilts it).
 fn bsdf_eval(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, front_face: bool) -> vec3<f32> {
     let cos_i = dot(wi, n);
-    if cos_i <= 0.0 || is_delta(m) {
+    if cos_i == 0.0 || (cos_i < 0.0 && !transmits_roughly(m)) || is_delta(m) {
         return vec3<f32>(0.0);
     }
     if is_pbr(m) {

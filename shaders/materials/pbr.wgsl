@@ -3,8 +3,8 @@
 // and the metal's, Kulla and Conty's multiple-scattering lobe, and the diffuse base under the
 // dielectric layer by reciprocal albedo scaling; with transmission T, (1 - T) of that stack and T
 // of rough_dielectric.wgsl's rough glass, its refraction tinted by the base colour. Refracted
-// samples are marked delta: shadow rays do not pass through surfaces, so what they reach counts
-// in full. Over that stack the sheen (sheen.wgsl) and over it the coat (clearcoat.wgsl), each
+// samples are delta only where the refraction is (roughness 0, or ior 1); elsewhere light
+// sampling evaluates the rough BTDF through the surface and MIS weighs the two. Over that stack the sheen (sheen.wgsl) and over it the coat (clearcoat.wgsl), each
 // scaling what lies below: f = coat + below_coat (sheen + below_sheen base).
 
 // The smallest GGX alpha of the material (roughness 0.032).
@@ -13,6 +13,13 @@ const PBR_MIN_ALPHA: f32 = 1e-3;
 const MIN_LOBE_PROBABILITY: f32 = 0.1;
 // The most the coat's and the sheen's lobes are each sampled with.
 const MAX_LAYER_PROBABILITY: f32 = 0.45;
+
+// Whether the material's refraction is a delta, which light sampling cannot evaluate:
+// roughness 0 (alpha clamped to PBR_MIN_ALPHA, a needle no light sample would meet), or ior 1,
+// where every microfacet refracts straight through.
+fn pbr_refraction_is_delta(m: Material) -> bool {
+    return m.alpha <= 0.0 || m.ior == 1.0;
+}
 
 struct PbrLobes {
     base: vec3<f32>,
@@ -29,6 +36,8 @@ struct PbrLobes {
     // The transmissive share of the dielectric part, and eta(other side) / eta(wo's side).
     transmission: f32,
     etap: f32,
+    // Refracted samples are delta (pbr_refraction_is_delta).
+    refraction_is_delta: bool,
     specular_probability: f32,
     transmission_probability: f32,
     // The coat and the sheen (none where the material has none or they are compiled out),
@@ -78,6 +87,7 @@ fn pbr_lobes(m: Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> PbrLob
     l.metallic = m.metallic;
     l.transmission = select(0.0, m.transmission, HAS_TRANSMISSION);
     l.etap = select(1.0 / m.ior, m.ior, front_face);
+    l.refraction_is_delta = pbr_refraction_is_delta(m);
     // The opaque dielectric stack's share.
     let opaque = (1.0 - l.metallic) * (1.0 - l.transmission);
     let specular = opaque * (l.dielectric_f0 * ab_o.x + vec3<f32>(l.dielectric_f90 * ab_o.y))
@@ -246,7 +256,7 @@ fn pbr_sample(l: PbrLobes, wo: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, choic
             let share = (1.0 - l.metallic) * l.transmission * l.layers_o / p_transmission;
             out.weight = l.base * (s.weight * share);
             out.pdf = p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo_l, s.wi);
-            out.is_delta = true;
+            out.is_delta = l.refraction_is_delta;
             return out;
         }
     } else if choice < p_transmission + l.specular_probability {

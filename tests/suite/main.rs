@@ -39,6 +39,7 @@ mod alpha;
 mod clearcoat_normals;
 mod normal_maps;
 mod pbr;
+mod rough_glass;
 mod shading_normals;
 mod textured_emitters;
 mod textures;

@@ -294,8 +294,16 @@ fn add_unblocked_light(
     if !f_cos.cmpgt(Vec3::ZERO).any() {
         return;
     }
+    // A light behind a rough transmissive surface (bsdf_eval passes it only there) is reached
+    // through the surface itself: the shadow ray starts on its far side, so that this surface
+    // does not block it while every other one (a closed object's far wall) still does.
+    let origin = if light.dir.dot(hit.normal) < 0.0 {
+        offset_ray_origin(hit.position, hit.error, -hit.normal)
+    } else {
+        vertex.origin
+    };
     let shadow = Ray {
-        origin: vertex.origin,
+        origin,
         dir: light.dir,
     };
     *segments += 1;

@@ -10,6 +10,6 @@ pub struct BsdfSample {
     /// Solid-angle pdf of `dir`; 0 for delta lobes.
     pub pdf: f32,
     /// Light sampling cannot find `dir`, so what the ray reaches counts in full: delta lobes,
-    /// and refraction (shadow rays do not pass through surfaces).
+    /// smooth refraction among them (material.rs's `transmits_roughly` says which is rough).
     pub is_delta: bool,
 }

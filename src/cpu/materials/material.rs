@@ -9,7 +9,9 @@ use crate::cpu::materials::conductor::{conductor_eval, conductor_sample, MIN_MET
 use crate::cpu::materials::dielectric::dielectric_sample;
 use crate::cpu::materials::diffuse::{diffuse_eval, diffuse_sample};
 use crate::cpu::materials::microfacet::ggx_reflection_pdf;
-use crate::cpu::materials::pbr::{pbr_eval, pbr_lobes, pbr_pdf, pbr_sample};
+use crate::cpu::materials::pbr::{
+    pbr_eval, pbr_lobes, pbr_pdf, pbr_refraction_is_delta, pbr_sample,
+};
 use crate::kernel::types::{
     Material, MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR, MATERIAL_SPECULAR,
 };
@@ -22,10 +24,20 @@ pub fn is_delta(m: &Material) -> bool {
         || (m.kind == MATERIAL_METAL && m.alpha < MIN_METAL_ALPHA)
 }
 
+/// Whether light sampling may evaluate the material below its surface: a pbr material with a
+/// rough transmission lobe (pbr.rs's `pbr_refraction_is_delta` says when it is not rough).
+pub fn transmits_roughly(m: &Material) -> bool {
+    m.kind == MATERIAL_PBR
+        && m.transmission > 0.0
+        && m.metallic < 1.0
+        && !pbr_refraction_is_delta(m)
+}
+
 /// f · cos θi for light arriving from wi and leaving towards wo (n faces wo; `front_face` says
-/// whether that is the outside). Zero for delta lobes and for wi below the surface (light
-/// sampling's shadow rays do not pass through surfaces). `coat_n`, facing wo too, is the pbr
-/// coat's own shading normal (KHR_materials_clearcoat's: n itself where nothing tilts it).
+/// whether that is the outside). Zero for delta lobes, and for wi below the surface except
+/// through a rough transmission lobe ([`transmits_roughly`]), whose light samples' shadow
+/// rays leave through the surface. `coat_n`, facing wo too, is the pbr coat's own shading
+/// normal (KHR_materials_clearcoat's: n itself where nothing tilts it).
 pub fn bsdf_eval(
     m: &Material,
     wo: Vec3,
@@ -35,7 +47,7 @@ pub fn bsdf_eval(
     front_face: bool,
 ) -> Vec3 {
     let cos_i = wi.dot(n);
-    if cos_i <= 0.0 || is_delta(m) {
+    if cos_i == 0.0 || (cos_i < 0.0 && !transmits_roughly(m)) || is_delta(m) {
         return Vec3::ZERO;
     }
     if m.kind == MATERIAL_PBR {

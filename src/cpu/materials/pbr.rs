@@ -32,9 +32,10 @@
 //! the specular lobe (visible normals), the coat's lobe (visible normals), the sheen's
 //! (uniform) or a cosine lobe (for the diffuse and multiple-scattering lobes) with
 //! probabilities from their albedos at μo, and weights by the mixture pdf, which MIS uses
-//! too. Refracted samples are marked delta: shadow rays do not
-//! pass through surfaces, so light sampling cannot find what lies behind one, and what such a
-//! sample reaches must count in full.
+//! too. Refracted samples are delta only where the refraction is (roughness 0, or ior 1, where
+//! the lobe refracts straight through): elsewhere light sampling evaluates the rough BTDF for
+//! lights on the far side (its shadow rays leave through the surface), and what a refracted
+//! sample reaches shares its light with it by MIS.
 
 use crate::cpu::core::frame::{from_local, to_local, PI};
 use crate::cpu::materials::bsdf::BsdfSample;
@@ -67,6 +68,13 @@ const MIN_LOBE_PROBABILITY: f32 = 0.1;
 /// keeps at least 1 − 2 · 0.45 of the samples.
 const MAX_LAYER_PROBABILITY: f32 = 0.45;
 
+/// Whether the material's refraction is a delta, which light sampling cannot evaluate:
+/// roughness 0 (the lobe's α is then clamped to PBR_MIN_ALPHA, a needle no light sample
+/// would meet), or ior 1, where every microfacet refracts straight through.
+pub fn pbr_refraction_is_delta(m: &Material) -> bool {
+    m.alpha <= 0.0 || m.ior == 1.0
+}
+
 /// What the lobes need at one shading point, from the material and μo.
 #[derive(Clone, Copy, Debug)]
 pub struct PbrLobes {
@@ -87,6 +95,8 @@ pub struct PbrLobes {
     /// The transmissive share T of the dielectric part, and η(the other side) / η(wo's side).
     transmission: f32,
     etap: f32,
+    /// Refracted samples are delta ([`pbr_refraction_is_delta`]).
+    refraction_is_delta: bool,
     /// Probabilities of sampling the specular lobe and the transmission lobe (the cosine lobe
     /// has the rest).
     specular_probability: f32,
@@ -244,6 +254,7 @@ pub fn pbr_lobes(m: &Material, mu_o: f32, coat_mu_o: f32, front_face: bool) -> P
         layer_average,
         transmission,
         etap: if front_face { m.ior } else { 1.0 / m.ior },
+        refraction_is_delta: pbr_refraction_is_delta(m),
         specular_probability,
         transmission_probability,
         coat,
@@ -384,7 +395,7 @@ pub fn pbr_sample(
                 dir,
                 weight: l.base * (s.weight * share),
                 pdf: p_transmission * rough_dielectric_pdf(l.alpha, l.etap, wo_l, s.wi),
-                is_delta: true,
+                is_delta: l.refraction_is_delta,
             };
         }
         (dir, s.wi)
