@@ -89,15 +89,16 @@ fn z_test(a: &(Image, Image), b: &(Image, Image)) -> ZTest {
 /// sphere and lamp: docs/src/performance/validation.md, issue 31).
 ///
 /// "The same image": the z of the difference of the image means below 4 (statistics.rs's
-/// bound, two-sided false alarm 6·10⁻⁵), at 1024 spp each: at 256 spp with light sampling
-/// (and 1024 without) the roughness-0.3 sphere under the sky measured z −4.0, while 4096 spp
-/// against 8192 measured −0.43 (the pixel means are skewed at few samples, as statistics.rs
-/// finds for the Cornell box). Under the sky, also ≥ 97% of the pixel channels within |z| ≤
-/// 2.576 (statistics.rs). Not under the lamp: without light sampling, a dark pixel finds the
-/// lamp through the glass so rarely that at 1024 spp many have no sample of it at all (mean
-/// and variance 0), and the per-pixel normal approximation fails (we measured 72–79% there,
-/// variance ratio 0.8–1.05, z of means within ±1.3); the image mean, a sum over 768 channels,
-/// is near normal.
+/// bound, two-sided false alarm 6·10⁻⁵), at 1024 spp with light sampling and 1024 (sky) or
+/// 2048 (lamp) without. With fewer samples the skew of the pixel means shows: at 256 spp with
+/// light sampling and 1024 without, the roughness-0.3 sphere under the sky measured z −4.0,
+/// where `glint render` at 4096 against 8192 spp measured −0.43; under the lamp, with 1024 spp
+/// without light sampling, −3.9 at roughness 0.3 (−3.05 with 2048, and −2.1 at 8192 against
+/// 16384). Under the sky, also ≥ 97% of the pixel channels within |z| ≤ 2.576 (statistics.rs;
+/// measured 98.8–99.2%). Not under the lamp: without light sampling a dark pixel finds the lamp
+/// through the glass so rarely that many have no sample of it at all (mean and variance 0),
+/// and the per-pixel normal approximation fails (measured 66–88%); the image mean, a sum over
+/// 768 channels, is near normal. The measured figures print with `--nocapture`.
 #[test]
 fn light_sampling_through_rough_glass_changes_only_the_noise() {
     const SPP_ON: u32 = 1024;
