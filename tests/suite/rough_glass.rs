@@ -10,7 +10,8 @@
 use crate::common;
 use common::{render_with_variance, with_light_sampling, write_map};
 use glam::Vec3;
-use glint::cpu::materials::material::{bsdf_eval, bsdf_pdf, transmits_roughly};
+use glint::cpu::core::rng::Rng;
+use glint::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, transmits_roughly};
 use glint::image::compare::{compare, ZTest};
 use glint::image::output::Image;
 use glint::kernel::types::{Material, MATERIAL_PBR};
@@ -157,9 +158,9 @@ fn light_sampling_through_rough_glass_changes_only_the_noise() {
     }
 }
 
-/// Light sampling evaluates rough transmission below the surface with the mixture's own f and
-/// pdf, and nothing below a smooth (roughness 0) or index-matched (ior 1) one, whose refraction
-/// stays a delta that BSDF sampling alone finds.
+/// Light sampling evaluates rough transmission below the surface (f and pdf both positive),
+/// and nothing below a smooth (roughness 0) or index-matched (ior 1) one, whose refraction
+/// stays a delta that BSDF sampling alone finds: the sampler marks exactly those delta.
 #[test]
 fn only_rough_refraction_is_light_sampled() {
     let glass = |roughness: f32, ior: f32| Material {
@@ -184,6 +185,23 @@ fn only_rough_refraction_is_light_sampled() {
         for m in [glass(0.0, 1.5), glass(0.6, 1.0)] {
             assert!(!transmits_roughly(&m));
             assert_eq!(bsdf_eval(&m, wo, wi, n, n, front), Vec3::ZERO);
+        }
+        // The sampler agrees: its refractions are delta exactly where light sampling skips them.
+        for (m, delta) in [
+            (rough, false),
+            (glass(0.0, 1.5), true),
+            (glass(0.6, 1.0), true),
+        ] {
+            let mut refractions = 0;
+            for i in 0..256 {
+                let mut rng = Rng::new(i, 1, 2, 3);
+                let s = bsdf_sample(&m, wo, n, n, front, &mut rng);
+                if s.weight != Vec3::ZERO && s.dir.z < 0.0 {
+                    assert_eq!(s.is_delta, delta, "roughness² {}, ior {}", m.alpha, m.ior);
+                    refractions += 1;
+                }
+            }
+            assert!(refractions > 0);
         }
     }
 }
