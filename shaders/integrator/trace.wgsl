@@ -74,6 +74,18 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     return scatter(path, m, hit, coat_normal, pixel, sample);
 }
 
+// The MIS weight of the light that a BSDF-sampled ray reaches on emitter (primitive, index),
+// against light sampling from the vertex the ray left: 1 where light sampling is off or could
+// not have found the ray (it left a delta lobe).
+fn bsdf_ray_mis_weight(path: ptr<function, PathState>, primitive: u32, index: u32, light_sampling: bool) -> f32 {
+    if light_sampling && !(*path).came_from_delta {
+        let ray = (*path).ray;
+        let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, primitive, index);
+        return power_heuristic((*path).bsdf_pdf_of_ray, pdf);
+    }
+    return 1.0;
+}
+
 // The path's ray left the scene: the background or the environment map, and the sun disks,
 // weighted against next-event estimation from the previous vertex.
 fn add_escaped_light(path: ptr<function, PathState>, light_sampling: bool) {
@@ -88,10 +100,7 @@ fn add_escaped_light(path: ptr<function, PathState>, light_sampling: bool) {
     if HAS_ENVIRONMENT {
         // The map is an emitter like the others: a BSDF-sampled ray that reaches it
         // shares its light with next-event estimation from the previous vertex.
-        if light_sampling && !(*path).came_from_delta {
-            let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, PRIMITIVE_ENVIRONMENT, 0u);
-            escaped *= power_heuristic((*path).bsdf_pdf_of_ray, pdf);
-        }
+        escaped *= bsdf_ray_mis_weight(path, PRIMITIVE_ENVIRONMENT, 0u, light_sampling);
     }
     if HAS_SUN_DISKS {
         let mis = light_sampling && !(*path).came_from_delta;
@@ -128,12 +137,7 @@ fn apply_normal_maps(m: Material, hit: ptr<function, Hit>, wo: vec3<f32>) -> vec
 // bounces count in full.
 fn add_hit_emission(path: ptr<function, PathState>, m: Material, hit: Hit, light_sampling: bool) {
     if any(m.emission > vec3<f32>(0.0)) {
-        let ray = (*path).ray;
-        var weight = 1.0;
-        if light_sampling && !(*path).came_from_delta {
-            let pdf = light_pdf((*path).ray_start, ray.origin, ray.dir, hit.primitive, hit.index);
-            weight = power_heuristic((*path).bsdf_pdf_of_ray, pdf);
-        }
+        let weight = bsdf_ray_mis_weight(path, hit.primitive, hit.index, light_sampling);
         (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, (*path).bounce);
     }
 }

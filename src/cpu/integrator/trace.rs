@@ -145,6 +145,24 @@ struct Vertex<'a> {
     origin: Vec3,
 }
 
+/// The MIS weight of the light that a BSDF-sampled ray reaches on emitter (primitive, index),
+/// against light sampling from the vertex the ray left: 1 where light sampling is off or could
+/// not have found the ray (it left a delta lobe).
+fn bsdf_ray_mis_weight(
+    scene: &SceneRefs,
+    path: &PathState,
+    primitive: u32,
+    index: u32,
+    light_sampling: bool,
+) -> f32 {
+    if light_sampling && !path.came_from_delta {
+        let ray = path.ray;
+        let pdf = light_pdf(scene, path.ray_start, ray.origin, ray.dir, primitive, index);
+        return power_heuristic(path.bsdf_pdf_of_ray, pdf);
+    }
+    1.0
+}
+
 /// The path's ray left the scene: the background or the environment map, and the sun disks,
 /// weighted against next-event estimation from the previous vertex.
 fn add_escaped_light(scene: &SceneRefs, path: &mut PathState, light_sampling: bool) {
@@ -161,17 +179,7 @@ fn add_escaped_light(scene: &SceneRefs, path: &mut PathState, light_sampling: bo
     if params.environment_width > 0 {
         // The map is an emitter like the others: a BSDF-sampled ray that reaches it
         // shares its light with next-event estimation from the previous vertex.
-        if light_sampling && !path.came_from_delta {
-            let pdf = light_pdf(
-                scene,
-                path.ray_start,
-                ray.origin,
-                ray.dir,
-                PRIMITIVE_ENVIRONMENT,
-                0,
-            );
-            escaped *= power_heuristic(path.bsdf_pdf_of_ray, pdf);
-        }
+        escaped *= bsdf_ray_mis_weight(scene, path, PRIMITIVE_ENVIRONMENT, 0, light_sampling);
     }
     // The kernel compiles sun disks in only for scenes that have one (HAS_SUN_DISKS).
     if params.light_count > 0 {
@@ -228,19 +236,7 @@ fn add_hit_emission(
 ) {
     let emission = Vec3::from(m.emission);
     if emission.cmpgt(Vec3::ZERO).any() {
-        let ray = path.ray;
-        let mut weight = 1.0;
-        if light_sampling && !path.came_from_delta {
-            let pdf = light_pdf(
-                scene,
-                path.ray_start,
-                ray.origin,
-                ray.dir,
-                hit.primitive,
-                hit.index,
-            );
-            weight = power_heuristic(path.bsdf_pdf_of_ray, pdf);
-        }
+        let weight = bsdf_ray_mis_weight(scene, path, hit.primitive, hit.index, light_sampling);
         path.radiance += firefly_clamp(
             scene.params,
             path.throughput * emission * weight,
