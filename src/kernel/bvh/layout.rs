@@ -19,10 +19,11 @@ impl BvhLayout {
         overridden().unwrap_or(BvhLayout::Wide)
     }
 
-    /// The CPU reference's: binary, as the wide tree measured no faster there (1.03× at 10³
-    /// triangles, 0.82× at 10⁵, 0.62× at 10⁶, medians of three interleaved rounds).
+    /// The CPU reference's: wide, walked with SIMD box and triangle tests
+    /// (src/cpu/traverse/wide.rs): 0.72× the binary walk's instructions per path on the bunny,
+    /// 0.63× on 10⁶ triangles (performance docs, 2026-12-04).
     pub fn for_cpu() -> BvhLayout {
-        overridden().unwrap_or(BvhLayout::Binary)
+        overridden().unwrap_or(BvhLayout::Wide)
     }
 
     pub fn name(&self) -> &'static str {
