@@ -16,6 +16,8 @@ use crate::cpu::geometry::alpha::alpha_skips;
 use crate::cpu::geometry::hit::{hit_comes_first, ClosestPrimitive, NO_HIT};
 use crate::cpu::geometry::scene_geometry::Geometry;
 use crate::cpu::traverse::bvh_ray::{hit_primitive, widened, BvhRay, NO_PRIMITIVE};
+#[cfg(target_arch = "x86_64")]
+use crate::cpu::traverse::lanes::Sse;
 use crate::cpu::traverse::lanes::{Portable, WideLanes};
 use crate::kernel::bvh::wide::WIDE_STACK_SIZE;
 use crate::kernel::types::{
@@ -31,29 +33,25 @@ pub use crate::cpu::traverse::lanes::hit_wide_boxes;
 pub enum WideTests {
     /// `glam` and the scalar triangle test, on any target.
     Portable,
-    /// SSE2 (every x86-64 CPU).
+    /// SSE2, which every x86-64 CPU has. AVX2 measured no faster: the tests compiled for it
+    /// (three-operand forms), and eight triangles per test in 256-bit registers, both took
+    /// 1.03-1.08x SSE2's CPU time on the bunny (performance docs, 2026-12-04): a 4-wide tree
+    /// gives a box test four lanes, and its leaves hold four triangles most often.
     Sse2,
-    /// The SSE2 tests, compiled for AVX2 (its three-operand forms).
-    Avx2,
 }
 
 impl WideTests {
-    /// The fastest this CPU has.
+    /// The fastest this target has.
     pub fn detected() -> WideTests {
         #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                return WideTests::Avx2;
-            }
-            WideTests::Sse2
-        }
+        return WideTests::Sse2;
         #[cfg(not(target_arch = "x86_64"))]
         WideTests::Portable
     }
 
-    /// [`WideTests::detected`], or what `GLINT_WIDE_TESTS=portable|sse2|avx2` names, for
-    /// measuring one against another; a kind this CPU lacks, or any other value, is ignored
-    /// with a warning.
+    /// [`WideTests::detected`], or what `GLINT_WIDE_TESTS=portable|sse2` names, for
+    /// measuring one against the other; a kind this target lacks, or any other value, is
+    /// ignored with a warning.
     pub fn chosen() -> WideTests {
         let detected = WideTests::detected();
         let Ok(name) = std::env::var("GLINT_WIDE_TESTS") else {
@@ -64,7 +62,7 @@ impl WideTests {
             .find(|t| t.name() == name);
         named.unwrap_or_else(|| {
             crate::errln!(
-                "glint: GLINT_WIDE_TESTS={name} is not one this CPU runs; using {}",
+                "glint: GLINT_WIDE_TESTS={name} is not one this target runs; using {}",
                 detected.name()
             );
             detected
@@ -75,20 +73,14 @@ impl WideTests {
         match self {
             WideTests::Portable => "portable",
             WideTests::Sse2 => "sse2",
-            WideTests::Avx2 => "avx2",
         }
     }
 
-    /// Every kind this CPU can run (for tests that compare them).
+    /// Every kind this target runs (for tests that compare them).
     pub fn available() -> Vec<WideTests> {
         let mut out = vec![WideTests::Portable];
         #[cfg(target_arch = "x86_64")]
-        {
-            out.push(WideTests::Sse2);
-            if std::arch::is_x86_feature_detected!("avx2") {
-                out.push(WideTests::Avx2);
-            }
-        }
+        out.push(WideTests::Sse2);
         out
     }
 }
@@ -124,7 +116,7 @@ pub fn wide_traverse(
     )
 }
 
-/// [`wide_traverse`] on the lanes `tests`, which this CPU must have
+/// [`wide_traverse`] on the lanes `tests`, which this target must have
 /// ([`WideTests::available`]).
 pub fn wide_traverse_with(
     tests: WideTests,
@@ -143,37 +135,8 @@ pub fn wide_traverse_with(
     };
     match tests {
         #[cfg(target_arch = "x86_64")]
-        WideTests::Avx2 => {
-            assert!(std::arch::is_x86_feature_detected!("avx2"));
-            // SAFETY: the CPU has AVX2, checked above.
-            unsafe { x86::walk_avx2(geometry, r, search) }
-        }
-        #[cfg(target_arch = "x86_64")]
-        WideTests::Sse2 => x86::walk_sse2(geometry, r, search),
+        WideTests::Sse2 => walk(&Sse::new(r), geometry, r, search),
         _ => walk(&Portable(r), geometry, r, search),
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-mod x86 {
-    use super::{walk, Search};
-    use crate::cpu::geometry::hit::ClosestPrimitive;
-    use crate::cpu::geometry::scene_geometry::Geometry;
-    use crate::cpu::traverse::bvh_ray::BvhRay;
-    use crate::cpu::traverse::lanes::Sse;
-
-    pub(super) fn walk_sse2(geometry: &Geometry, r: &BvhRay, search: Search) -> ClosestPrimitive {
-        walk(&Sse::new(r), geometry, r, search)
-    }
-
-    /// The same walk and tests, compiled with AVX2 enabled.
-    #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn walk_avx2(
-        geometry: &Geometry,
-        r: &BvhRay,
-        search: Search,
-    ) -> ClosestPrimitive {
-        walk(&Sse::new(r), geometry, r, search)
     }
 }
 
