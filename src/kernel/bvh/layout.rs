@@ -19,9 +19,10 @@ impl BvhLayout {
         overridden().unwrap_or(BvhLayout::Wide)
     }
 
-    /// The CPU reference's: wide, walked with SIMD box and triangle tests
-    /// (src/cpu/traverse/wide.rs): 0.72× the binary walk's instructions per path on the bunny,
-    /// 0.63× on 10⁶ triangles (performance docs, 2026-12-04).
+    /// The CPU reference's: wide, walked with SSE2 box and triangle tests
+    /// (src/cpu/traverse/wide.rs): 0.71× the binary walk's instructions per path on the bunny
+    /// and 0.74× its CPU time, 0.63× the instructions on 10⁶ triangles
+    /// (docs/src/performance/history/2026-12-04.md).
     pub fn for_cpu() -> BvhLayout {
         overridden().unwrap_or(BvhLayout::Wide)
     }
