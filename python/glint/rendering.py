@@ -65,6 +65,7 @@ def render(
     max_bounces=None,
     seed=None,
     light_sampling=None,
+    sampler=None,
     device="auto",
     traversal="auto",
     variance=False,
@@ -77,8 +78,8 @@ def render(
     """Renders `scene` and returns its image: a float32 NumPy array, H×W×3, linear radiance.
 
     The keyword arguments are `glint render`'s overrides, with the same names and meanings:
-    spp, width, height, max_bounces, seed, light_sampling (True/False or "on"/"off"); None
-    keeps the scene's value. device is "auto" (the GPU if there is one, else the CPU
+    spp, width, height, max_bounces, seed, light_sampling (True/False or "on"/"off"), sampler
+    ("independent" or "sobol"); None keeps the scene's value. device is "auto" (the GPU if there is one, else the CPU
     reference), "gpu" (or a RuntimeError) or "cpu". time_limit (seconds) stops at the first
     batch boundary after it; progress prints the sample count on stderr. denoise=True runs
     Open Image Denoise on the result as `glint render --denoise` does (a RuntimeError with
@@ -120,6 +121,7 @@ def render(
         max_bounces=_integer("max_bounces", max_bounces),
         seed=_integer("seed", seed),
         light_sampling=_on_off(light_sampling),
+        sampler=sampler,
         device=device,
         traversal=traversal,
         variance=bool(variance),

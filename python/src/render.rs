@@ -12,7 +12,9 @@ use glint::error::InputError;
 use glint::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
 use glint::kernel::KernelScene;
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
-use glint::scene::{self as scenes, RenderOverrides, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use glint::scene::{
+    self as scenes, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -248,7 +250,7 @@ fn run_gpu(
 /// the image and the other outputs as H×W×3 float32 NumPy arrays, and the statistics.
 #[pyfunction]
 #[pyo3(signature = (scene, *, spp=None, width=None, height=None, max_bounces=None, seed=None,
-    light_sampling=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
+    light_sampling=None, sampler=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
     time_limit=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
@@ -260,6 +262,7 @@ pub fn render<'py>(
     max_bounces: Option<i64>,
     seed: Option<i64>,
     light_sampling: Option<bool>,
+    sampler: Option<&str>,
     device: &str,
     traversal: &str,
     variance: bool,
@@ -278,6 +281,15 @@ pub fn render<'py>(
         max_bounces: checked("max_bounces", max_bounces, 0, MAX_BOUNCES_LIMIT as i64)?,
         seed: checked("seed", seed, 0, u32::MAX as i64)?,
         light_sampling,
+        sampler: sampler
+            .map(|s| {
+                Sampler::from_name(s).ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "sampler: expected \"independent\" or \"sobol\", got {s:?}"
+                    ))
+                })
+            })
+            .transpose()?,
     };
     let time_limit = match time_limit {
         Some(t) if !(0.0..=1e9).contains(&t) => {
@@ -367,6 +379,7 @@ pub fn render<'py>(
     stats.set_item("max_bounces", r.max_bounces)?;
     stats.set_item("seed", r.seed)?;
     stats.set_item("light_sampling", r.light_sampling)?;
+    stats.set_item("sampler", r.sampler.name())?;
     stats.set_item("paths", paths)?;
     stats.set_item("seconds", rendered.seconds)?;
     stats.set_item(

@@ -50,6 +50,8 @@ struct Params {
     light_count: u32,
     // PROJECTION_PERSPECTIVE or PROJECTION_ORTHOGRAPHIC (camera.wgsl).
     projection: u32,
+    // SAMPLER_INDEPENDENT or SAMPLER_SOBOL (rng.wgsl).
+    sampler: u32,
 }
 
 // Params.projection: camera rays from the eye (or the lens) through the image plane, or

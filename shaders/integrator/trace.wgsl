@@ -30,7 +30,7 @@ fn firefly_clamp(contribution: vec3<f32>, scatterings: u32) -> vec3<f32> {
 }
 
 fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
-    var camera_rng = rng_init(pixel, sample, 0u, params.seed);
+    var camera_rng = rng_stream(pixel, sample, 0u, params.seed, params.sampler);
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let ray = camera_ray(px, py, jitter, lens);
@@ -153,7 +153,7 @@ fn add_light_sample(
     pixel: u32,
     sample: u32,
 ) {
-    var light_rng = rng_init(pixel, sample, stream_id((*path).bounce, PURPOSE_LIGHT), params.seed);
+    var light_rng = rng_stream(pixel, sample, stream_id((*path).bounce, PURPOSE_LIGHT), params.seed, params.sampler);
     let light = sample_light(hit.position, origin, &light_rng);
     if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
         add_unblocked_light(path, m, hit, coat_normal, origin, light, pixel, sample);
@@ -211,7 +211,7 @@ fn scatter(
     let bounce = (*path).bounce;
     let p = hit.position;
     let wo = -(*path).ray.dir;
-    var bsdf_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+    var bsdf_rng = rng_stream(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed, params.sampler);
     let s = bsdf_sample(m, wo, hit.shading_normal, coat_normal, hit.front_face, &bsdf_rng);
     var throughput = (*path).throughput * s.weight;
     if all(throughput == vec3<f32>(0.0)) || crosses_shading_side(s.dir, hit) {
@@ -220,7 +220,7 @@ fn scatter(
     if bounce >= params.roulette_start {
         // Russian roulette: continue with probability q and divide by it, so the estimate
         // stays unbiased while dim paths end early.
-        var roulette_rng = rng_init(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed);
+        var roulette_rng = rng_stream(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed, params.sampler);
         let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
         if rng_next(&roulette_rng) >= q {
             return true;

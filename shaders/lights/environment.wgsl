@@ -58,7 +58,7 @@ struct EnvironmentSample {
 // A direction towards the map, drawn in proportion to luminance: a texel by the alias table
 // (u.x picks the entry, u.y decides between it and its alias), then uniformly in solid angle
 // within it (rng's next two numbers: phi, then cos theta).
-fn sample_environment(u: vec2<f32>, rng: ptr<function, u32>) -> EnvironmentSample {
+fn sample_environment(u: vec2<f32>, rng: ptr<function, Rng>) -> EnvironmentSample {
     let w = params.environment_width;
     let h = params.environment_height;
     let n = w * h;

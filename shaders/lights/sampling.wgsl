@@ -98,7 +98,7 @@ fn area_to_solid_angle(t: f32, cos_light: f32, area: f32) -> f32 {
 // and for a BSDF-sampled ray, so the two strategies' MIS weights match. `probe` is `p` moved
 // off the surface to the side light arrives from: it decides whether p is inside a sphere
 // (a point on the sphere itself is ambiguous) and starts the shadow ray.
-fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, u32>) -> LightSample {
+fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, Rng>) -> LightSample {
     var out: LightSample;
     out.pdf = 0.0;
     if emitter_count() == 0u {

@@ -14,7 +14,7 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 }
 
 // `front_face` says whether wo is on the outside; n faces wo.
-fn dielectric_sample(tint: vec3<f32>, ior: f32, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: ptr<function, u32>) -> BsdfSample {
+fn dielectric_sample(tint: vec3<f32>, ior: f32, wo: vec3<f32>, n: vec3<f32>, front_face: bool, rng: ptr<function, Rng>) -> BsdfSample {
     var out: BsdfSample;
     out.pdf = 0.0;
     out.is_delta = true;

@@ -67,7 +67,7 @@ fn bsdf_pdf(m: Material, wo: vec3<f32>, wi: vec3<f32>, n: vec3<f32>, coat_n: vec
 // Samples the direction light arrives from, for light leaving towards wo. `n` and `coat_n`
 // face wo (as for bsdf_eval); `front_face` says whether that is the outside (for glass and
 // transmission).
-fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, front_face: bool, rng: ptr<function, u32>) -> BsdfSample {
+fn bsdf_sample(m: Material, wo: vec3<f32>, n: vec3<f32>, coat_n: vec3<f32>, front_face: bool, rng: ptr<function, Rng>) -> BsdfSample {
     if m.kind == MATERIAL_SPECULAR {
         var out: BsdfSample;
         out.pdf = 0.0;

@@ -18,7 +18,7 @@ use crate::render::{
 };
 use crate::scene::model::ModelScene;
 use crate::scene::model_toml::model_toml;
-use crate::scene::{RenderOverrides, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use crate::scene::{RenderOverrides, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -55,6 +55,10 @@ pub struct RenderArgs {
     /// Next-event estimation with multiple importance sampling (overrides [render] light_sampling).
     #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
     pub light_sampling: Option<bool>,
+    /// Where each sample's random numbers come from (overrides [render] sampler; default
+    /// independent): independent numbers, or Owen-scrambled Sobol points (lower error).
+    #[arg(long, value_enum)]
+    pub sampler: Option<Sampler>,
     /// Render on the CPU reference.
     #[arg(long, conflicts_with = "gpu")]
     pub cpu: bool,
@@ -177,6 +181,7 @@ fn scene_to_render(args: &RenderArgs) -> Result<Option<Scene>> {
         max_bounces: args.max_bounces,
         seed: args.seed,
         light_sampling: args.light_sampling,
+        sampler: args.sampler,
     };
     let scene = scene
         .with_overrides(&overrides)
@@ -242,6 +247,7 @@ fn json_summary(
         "spp": run.stats.spp,
         "max_bounces": run.scene.render.max_bounces,
         "seed": run.scene.render.seed,
+        "sampler": run.scene.render.sampler.name(),
         "paths": paths,
         "seconds": seconds,
         "paths_per_second": paths as f64 / seconds.max(1e-9),

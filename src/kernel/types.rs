@@ -55,7 +55,9 @@ pub struct Params {
     pub light_count: u32,
     /// `PROJECTION_PERSPECTIVE` or `PROJECTION_ORTHOGRAPHIC` (`src/cpu/core/camera.rs`).
     pub projection: u32,
-    pub _pad: [u32; 3],
+    /// `SAMPLER_INDEPENDENT` or `SAMPLER_SOBOL` (`src/cpu/core/rng.rs`).
+    pub sampler: u32,
+    pub _pad: [u32; 2],
 }
 
 /// `Params::roulette_start` that turns Russian roulette off.

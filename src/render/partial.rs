@@ -110,6 +110,11 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         params_bytes
     };
     array("params", params_bytes);
+    // The sampler only where it is not the independent one, so earlier hashes stay as they
+    // were (a perspective camera's bytes above stop before it).
+    if params.sampler != 0 {
+        array("sampler", bytemuck::bytes_of(&params.sampler));
+    }
     array("spheres", bytemuck::cast_slice(spheres));
     array("quads", bytemuck::cast_slice(quads));
     array("materials", bytemuck::cast_slice(materials));

@@ -99,6 +99,7 @@ pub(super) struct RenderToml {
     pub(super) seed: Option<S<i64>>,
     pub(super) light_sampling: Option<bool>,
     pub(super) russian_roulette: Option<bool>,
+    pub(super) sampler: Option<S<String>>,
 }
 
 #[derive(Deserialize)]

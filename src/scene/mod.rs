@@ -201,6 +201,45 @@ pub struct RenderSettings {
     /// Next-event estimation with multiple importance sampling.
     pub light_sampling: bool,
     pub russian_roulette: bool,
+    /// Where a path's random numbers come from.
+    pub sampler: Sampler,
+}
+
+/// `[render] sampler`, `--sampler`: the numbers each sample's decisions draw.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Sampler {
+    /// Independent uniform numbers (a PCG stream per sample): what the statistical tests that
+    /// assume independent samples use.
+    #[default]
+    Independent,
+    /// Owen-scrambled Sobol points (hash-based, Burley 2020), each pair of draws of a decision
+    /// a 2D point: lower error at a given spp.
+    Sobol,
+}
+
+impl Sampler {
+    pub fn name(self) -> &'static str {
+        match self {
+            Sampler::Independent => "independent",
+            Sampler::Sobol => "sobol",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Sampler> {
+        match name {
+            "independent" => Some(Sampler::Independent),
+            "sobol" => Some(Sampler::Sobol),
+            _ => None,
+        }
+    }
+
+    /// `Params::sampler`.
+    pub fn kernel_value(self) -> u32 {
+        match self {
+            Sampler::Independent => crate::cpu::core::rng::SAMPLER_INDEPENDENT,
+            Sampler::Sobol => crate::cpu::core::rng::SAMPLER_SOBOL,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -379,6 +418,7 @@ pub struct RenderOverrides {
     pub max_bounces: Option<u32>,
     pub seed: Option<u32>,
     pub light_sampling: Option<bool>,
+    pub sampler: Option<Sampler>,
 }
 
 impl Scene {
@@ -457,6 +497,7 @@ impl Scene {
         r.max_bounces = o.max_bounces.unwrap_or(r.max_bounces);
         r.seed = o.seed.unwrap_or(r.seed);
         r.light_sampling = o.light_sampling.unwrap_or(r.light_sampling);
+        r.sampler = o.sampler.unwrap_or(r.sampler);
         check_image_size(r.width as i64, r.height as i64)?;
         check_range(r.spp as i64, 1, MAX_SPP as i64).map_err(|m| format!("spp {m}"))?;
         check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)

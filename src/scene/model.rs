@@ -220,6 +220,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
             seed: 0,
             light_sampling: true,
             russian_roulette: true,
+            sampler: Default::default(),
         },
         materials,
         spheres: Vec::new(),

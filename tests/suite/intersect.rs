@@ -47,6 +47,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             seed: 0,
             light_sampling: true,
             russian_roulette: true,
+            sampler: Default::default(),
         },
         materials: vec![Material {
             name: "m".into(),

@@ -543,3 +543,21 @@ fn alpha_fields_are_read_and_checked() {
         &["materials.white.alpha_cutoff", "must be in [0, 1]", "-1"],
     );
 }
+
+/// `[render] sampler` names one of the samplers; `--print-scene` writes it back.
+#[test]
+fn sampler_is_named() {
+    let good = edited("[render]", "[render]\nsampler = \"sobol\"");
+    let scene = parse(&good).unwrap();
+    assert_eq!(scene.render.sampler, glint::scene::Sampler::Sobol);
+    assert_eq!(
+        scene.kernel_scene().params.sampler,
+        glint::cpu::core::rng::SAMPLER_SOBOL
+    );
+    let bad = good.replace("\"sobol\"", "\"halton\"");
+    assert_error(
+        &bad,
+        None,
+        &["render.sampler", "halton", "independent", "sobol"],
+    );
+}

@@ -14,6 +14,7 @@ use glint::image::compare::compare;
 use glint::render::accumulation::Accumulation;
 use glint::render::partial::Partial;
 use glint::render::Renderer;
+use glint::scene::Sampler;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -139,13 +140,21 @@ fn gpu_shards_merge_to_the_single_render() {
 }
 
 /// Shards that are exactly a single render's batches merge to the same bits: the merge repeats
-/// the kernel's pairwise update in the same order.
+/// the kernel's pairwise update in the same order. With either sampler: a sample's numbers
+/// depend on its global index, not on the batch or shard that renders it.
 #[test]
 fn shards_that_are_the_batches_merge_bit_identically() {
+    for sampler in [Sampler::Independent, Sampler::Sobol] {
+        shards_merge_bit_identically(sampler);
+    }
+}
+
+fn shards_merge_bit_identically(sampler: Sampler) {
     let mut scene = common::shipped_scene("cornell.toml");
     scene.render.width = 16;
     scene.render.height = 16;
     scene.render.max_bounces = 4;
+    scene.render.sampler = sampler;
     let scene = scene.kernel_scene();
     let check = |make: &mut dyn FnMut() -> Box<dyn Renderer>, device: &str| {
         let mut single = make();
@@ -166,7 +175,7 @@ fn shards_that_are_the_batches_merge_bit_identically() {
             .count();
         assert_eq!(
             differing, 0,
-            "{device}: pixels differing from the single render"
+            "{device}, {sampler:?}: pixels differing from the single render"
         );
     };
     check(&mut || Box::new(CpuRenderer::new(&scene)), "cpu");
@@ -543,6 +552,13 @@ fn settings_hash_is_stable_across_loads_and_sees_changes() {
         let mut changed = common::shipped_scene(name).kernel_scene();
         changed.params.seed += 1;
         assert_ne!(settings_hash(&changed), first, "{name}: seed");
+        let mut changed = common::shipped_scene(name);
+        changed.render.sampler = Sampler::Sobol;
+        assert_ne!(
+            settings_hash(&changed.kernel_scene()),
+            first,
+            "{name}: sampler"
+        );
         let mut changed = common::shipped_scene(name).kernel_scene();
         if let Some(t) = changed.environment_texels.first_mut() {
             t.radiance[0] += 1.0;

@@ -53,7 +53,7 @@ pub fn firefly_clamp(params: &Params, contribution: Vec3, scatterings: u32) -> V
 }
 
 pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
-    let mut camera_rng = Rng::new(pixel, sample, 0, params.seed);
+    let mut camera_rng = Rng::with_sampler(pixel, sample, 0, params.seed, params.sampler);
     let jitter = (camera_rng.next_f32(), camera_rng.next_f32());
     let lens = (camera_rng.next_f32(), camera_rng.next_f32());
     let ray = camera_ray(params, px, py, jitter, lens);
@@ -258,7 +258,7 @@ fn add_light_sample(
     let params = scene.params;
     let hit = vertex.hit;
     let stream = stream_id(path.bounce, PURPOSE_LIGHT);
-    let mut light_rng = Rng::new(pixel, sample, stream, params.seed);
+    let mut light_rng = Rng::with_sampler(pixel, sample, stream, params.seed, params.sampler);
     let light = sample_light(scene, hit.position, vertex.origin, &mut light_rng);
     if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
         add_unblocked_light(scene, path, vertex, &light, pixel, sample, segments);
@@ -341,7 +341,13 @@ fn scatter(
     let bounce = path.bounce;
     let p = hit.position;
     let wo = -path.ray.dir;
-    let mut bsdf_rng = Rng::new(pixel, sample, stream_id(bounce, PURPOSE_BSDF), params.seed);
+    let mut bsdf_rng = Rng::with_sampler(
+        pixel,
+        sample,
+        stream_id(bounce, PURPOSE_BSDF),
+        params.seed,
+        params.sampler,
+    );
     let s = bsdf_sample(
         m,
         wo,
@@ -357,11 +363,12 @@ fn scatter(
     if bounce >= params.roulette_start {
         // Russian roulette: continue with probability q and divide by it, so the estimate
         // stays unbiased while dim paths end early.
-        let mut roulette_rng = Rng::new(
+        let mut roulette_rng = Rng::with_sampler(
             pixel,
             sample,
             stream_id(bounce, PURPOSE_ROULETTE),
             params.seed,
+            params.sampler,
         );
         let q = throughput.x.max(throughput.y.max(throughput.z)).min(0.95);
         if roulette_rng.next_f32() >= q {

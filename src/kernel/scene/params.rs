@@ -79,6 +79,7 @@ impl Scene {
                 .find(|e| e.primitive == PRIMITIVE_ENVIRONMENT)
                 .map_or(0.0, |e| e.probability),
             light_count: self.lights.len() as u32,
+            sampler: r.sampler.kernel_value(),
             ..Default::default()
         };
         place_camera(&mut params, &self.camera);

@@ -12,7 +12,9 @@ mod objects;
 pub(super) use fields::FieldError;
 
 use super::file::{RenderToml, SceneToml};
-use super::{check_image_size, RenderSettings, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use super::{
+    check_image_size, RenderSettings, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
 use fields::{fail, int_in, non_negative, radiance_in_range};
 use glam::Vec3;
 use std::ops::Range;
@@ -130,6 +132,20 @@ fn validate_render(
         Some(s) => int_in(s, "render.seed", 0, u32::MAX as i64)?,
         None => 0,
     };
+    let sampler = match &render.sampler {
+        Some(s) => match Sampler::from_name(s.get_ref()) {
+            Some(sampler) => sampler,
+            None => fail(
+                s.span(),
+                "render.sampler",
+                format!(
+                    "unknown sampler {:?}; known: \"independent\", \"sobol\"",
+                    s.get_ref()
+                ),
+            )?,
+        },
+        None => Sampler::default(),
+    };
     Ok(RenderSettings {
         width: width as u32,
         height: height as u32,
@@ -139,5 +155,6 @@ fn validate_render(
         seed,
         light_sampling: render.light_sampling.unwrap_or(true),
         russian_roulette: render.russian_roulette.unwrap_or(true),
+        sampler,
     })
 }

@@ -32,7 +32,17 @@ fn probe_uniform(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
+    probe_out[id.x] = vec4<f32>(rng_next(&rng), rng_next(&rng), rng_next(&rng), rng_next(&rng));
+}
+
+// The first four Sobol draws of sample id.x of pixel 7, stream 3 (two 2D points).
+@compute @workgroup_size(256, 1, 1)
+fn probe_sobol(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_stream(7u, id.x, 3u, probe.seed, SAMPLER_SOBOL);
     probe_out[id.x] = vec4<f32>(rng_next(&rng), rng_next(&rng), rng_next(&rng), rng_next(&rng));
 }
 
@@ -41,7 +51,7 @@ fn probe_cosine_hemisphere(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let u = vec2<f32>(rng_next(&rng), rng_next(&rng));
     probe_out[id.x] = vec4<f32>(sample_cosine_hemisphere(probe.normal, u), 0.0);
 }
@@ -52,7 +62,7 @@ fn probe_light(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let light = sample_light(probe.position, probe.side_probe, &rng);
     probe_out[id.x] = vec4<f32>(light.dir, light.pdf);
 }
@@ -74,7 +84,7 @@ fn probe_metal(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let s = bsdf_sample(probe_material(MATERIAL_METAL), probe.wo, probe.normal, probe.normal, true, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
@@ -85,7 +95,7 @@ fn probe_pbr(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     var m = probe_material(MATERIAL_PBR);
     m.specular = 1.0;
     m.specular_color = vec3<f32>(1.0);
@@ -104,7 +114,7 @@ fn probe_dielectric(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let s = bsdf_sample(probe_material(MATERIAL_DIELECTRIC), probe.wo, probe.normal, probe.normal, probe.front_face != 0u, &rng);
     probe_out[id.x] = vec4<f32>(s.dir, s.weight.x);
 }
@@ -118,7 +128,7 @@ fn probe_watertight(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let n = params.triangle_count;
     let tri = triangles[min(u32(rng_next(&rng) * f32(n)), n - 1u)];
     let along = rng_next(&rng);
@@ -164,7 +174,7 @@ fn probe_emitter_choice(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let u_slot = rng_next(&rng);
     let u_alias = rng_next(&rng);
     let e = pick_emitter(u_slot, u_alias);
@@ -185,7 +195,7 @@ fn probe_closest_hit(@builtin(global_invocation_id) id: vec3<u32>) {
     if 2u * id.x + 1u >= probe.count {
         return;
     }
-    var rng = rng_init(id.x, 0u, 1u, probe.seed);
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
     let box = vec3<f32>(rng_next(&rng), rng_next(&rng), rng_next(&rng)) - vec3<f32>(0.5);
     let origin = probe.position + probe.alpha * box;
     let pick = rng_next(&rng);
