@@ -73,6 +73,7 @@ fn gpu_render_to_png_reads_back_as_the_furnace() {
     assert_eq!(summary["paths"], 20 * 10 * 16);
     assert_eq!(summary["max_bounces"], 24);
     assert_eq!(summary["seed"], 0);
+    assert_eq!(summary["sampler"], "independent");
     assert!(summary["seconds"].as_f64().unwrap() > 0.0);
     assert!(summary["paths_per_second"].as_f64().unwrap() > 0.0);
     assert!(!summary["device"].as_str().unwrap().is_empty());
@@ -670,4 +671,41 @@ fn traversal_flag_picks_and_reports_the_traversal() {
         assert!(String::from_utf8_lossy(&hardware.stderr).contains("no ray queries"));
         assert!(!dir.path().join("hardware.png").exists());
     }
+}
+
+/// `--sampler sobol` reaches the render (its JSON says so and its image differs from the
+/// independent sampler's), `--print-scene` writes it, and an unknown sampler is refused.
+#[test]
+fn sampler_option() {
+    let dir = tempfile::tempdir().unwrap();
+    let cornell = scene_path("cornell.toml");
+    let cornell = cornell.to_str().unwrap();
+    let small = [
+        "--cpu", "--spp", "4", "--width", "16", "--height", "16", "--json",
+    ];
+    let mut images = Vec::new();
+    for sampler in ["independent", "sobol"] {
+        let output = format!("{sampler}.exr");
+        let mut args = vec!["render", cornell, "--sampler", sampler, "-o", &output];
+        args.extend(small);
+        let summary = json(&glint(dir.path(), &args));
+        assert_eq!(summary["sampler"], sampler);
+        images.push(glint::image::output::Image::read_exr(&dir.path().join(&output)).unwrap());
+    }
+    assert_ne!(images[0].pixels, images[1].pixels);
+    let bunny = scene_path("models/bunny.ply");
+    let printed = glint(
+        dir.path(),
+        &[
+            "render",
+            bunny.to_str().unwrap(),
+            "--sampler",
+            "sobol",
+            "--print-scene",
+        ],
+    );
+    assert!(printed.status.success());
+    assert!(String::from_utf8_lossy(&printed.stdout).contains("sampler = \"sobol\""));
+    let refused = glint(dir.path(), &["render", cornell, "--sampler", "halton"]);
+    assert!(!refused.status.success());
 }
