@@ -27,8 +27,8 @@ pub struct GpuCache {
 }
 
 /// Whether a renderer made for `a` renders `b` once given `b`'s parameters: everything but
-/// the camera, spp, seed, max_bounces, the background and light sampling (all in `Params`)
-/// is the same.
+/// the camera, spp, seed, max_bounces, the background, light sampling and the sampler (all in
+/// `Params`) is the same.
 pub fn same_objects(a: &scenes::Scene, b: &scenes::Scene) -> bool {
     a.render.width == b.render.width
         && a.render.height == b.render.height
