@@ -47,19 +47,17 @@ fn owen_scramble(x_in: u32, seed: u32) -> u32 {
     return reverseBits(x);
 }
 
-// The second Sobol dimension: column k of its matrix is row k of Pascal's triangle mod 2.
+// The second Sobol dimension: column k of its matrix is row k of Pascal's triangle mod 2, so
+// digit j is the XOR of the index bits k whose bits contain j's (Lucas): a superset-sum
+// transform in five steps.
 fn sobol_dimension1(index: u32) -> u32 {
-    var result = 0u;
-    var v = 1u << 31u;
-    var i = index;
-    while i != 0u {
-        if (i & 1u) != 0u {
-            result ^= v;
-        }
-        i >>= 1u;
-        v ^= v >> 1u;
-    }
-    return result;
+    var x = index;
+    x ^= (x >> 1u) & 0x55555555u;
+    x ^= (x >> 2u) & 0x33333333u;
+    x ^= (x >> 4u) & 0x0f0f0f0fu;
+    x ^= (x >> 8u) & 0x00ff00ffu;
+    x ^= x >> 16u;
+    return reverseBits(x);
 }
 
 fn sobol_bits(stream_seed: u32, pair: u32, dimension: u32, sample: u32) -> u32 {
