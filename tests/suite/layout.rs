@@ -117,7 +117,8 @@ fn rust_structs_match_wgsl_layout() {
             environment_sin,
             environment_light_probability,
             light_count,
-            projection
+            projection,
+            sampler
         ]
     );
     assert_same_layout!(
