@@ -11,7 +11,7 @@ use crate::common;
 use common::chi2::{
     assert_fits, directions, directions_integrated, directions_with_absorbed, pearson, uniform_2d,
 };
-use common::probe::{run_probe, ProbeParams};
+use common::probe::{run_probe, ProbeParams, PROBE_SCENE};
 use glam::Vec3;
 use glint::cpu::core::rng::Rng;
 use glint::cpu::materials::diffuse::sample_cosine_hemisphere;
@@ -41,21 +41,8 @@ fn probe(normal: Vec3, count: u32, seed: u32) -> ProbeParams {
 
 /// A scene for probes that read none of it.
 fn empty_scene() -> glint::kernel::KernelScene {
-    common::kernel_scene(SCENE_HEADER)
+    common::kernel_scene(PROBE_SCENE)
 }
-
-const SCENE_HEADER: &str = r#"
-[camera]
-eye = [0.0, 0.0, -5.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 40.0
-[render]
-width = 1
-height = 1
-spp = 1
-max_bounces = 1
-"#;
 
 fn cosine_pdf(n: Vec3) -> impl Fn(Vec3) -> f64 {
     move |d: Vec3| (d.dot(n) as f64).max(0.0) / PI
@@ -281,7 +268,7 @@ fn reference_light_pdf(scene: &glint::scene::Scene, p: glam::DVec3, dir: glam::D
 /// chooses among spheres, quads and triangles by power.
 fn lights_with_triangles() -> glint::scene::Scene {
     let mut scene = common::scene(&format!(
-        "{SCENE_HEADER}{TWO_LIGHTS}
+        "{PROBE_SCENE}{TWO_LIGHTS}
 [materials.tri_lamp]
 type = \"diffuse\"
 color = [0.0, 0.0, 0.0]
@@ -322,12 +309,12 @@ fn light_cases() -> [(&'static str, glint::scene::Scene, Vec3); 3] {
     [
         (
             "two lights",
-            common::scene(&format!("{SCENE_HEADER}{TWO_LIGHTS}")),
+            common::scene(&format!("{PROBE_SCENE}{TWO_LIGHTS}")),
             Vec3::ZERO,
         ),
         (
             "inside a light",
-            common::scene(&format!("{SCENE_HEADER}{INSIDE_LIGHT}")),
+            common::scene(&format!("{PROBE_SCENE}{INSIDE_LIGHT}")),
             Vec3::new(0.6, -0.4, 0.3),
         ),
         (
@@ -413,7 +400,7 @@ fn many_emitters() -> glint::scene::Scene {
     }
     toml += "[[spheres]]\ncenter = [0.0, -5.0, 0.0]\nradius = 0.3\nmaterial = \"ball_lamp\"\n";
     let mut scene = lights_with_triangles();
-    let extra = common::scene(&format!("{SCENE_HEADER}{TWO_LIGHTS}{toml}"));
+    let extra = common::scene(&format!("{PROBE_SCENE}{TWO_LIGHTS}{toml}"));
     // The triangles refer to materials by index: keep TWO_LIGHTS' materials first.
     let offset = scene.materials.len() as u32;
     scene.materials.extend(extra.materials);
@@ -839,7 +826,7 @@ fn environment_scene(case: &MapCase, dir: &std::path::Path) -> glint::scene::Sce
     .save(&path)
     .unwrap();
     common::scene(&format!(
-        "{SCENE_HEADER}[environment]\nfile = {:?}\nrotate = {}\n",
+        "{PROBE_SCENE}[environment]\nfile = {:?}\nrotate = {}\n",
         path.to_str().unwrap(),
         case.rotate
     ))
@@ -1033,7 +1020,7 @@ fn check_sun_samples(name: &str, samples: &[[f32; 4]]) {
 
 #[test]
 fn cpu_sun_disk_sampling() {
-    let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
+    let kernel = common::kernel_scene(&format!("{PROBE_SCENE}{SUN}"));
     let refs = glint::cpu::scene_refs::SceneRefs::of(&kernel, &kernel.params);
     let samples: Vec<[f32; 4]> = (0..SAMPLES)
         .map(|i| {
@@ -1049,7 +1036,7 @@ fn cpu_sun_disk_sampling() {
 #[test]
 fn gpu_sun_disk_sampling() {
     let Some(ctx) = common::gpu() else { return };
-    let kernel = common::kernel_scene(&format!("{SCENE_HEADER}{SUN}"));
+    let kernel = common::kernel_scene(&format!("{PROBE_SCENE}{SUN}"));
     let samples = run_probe(
         ctx,
         "probe_light",

@@ -3,7 +3,7 @@
 //! an orthographic one, with either sampler.
 
 use crate::common;
-use common::probe::{run_probe, ProbeParams};
+use common::probe::{run_probe, ProbeParams, PROBE_SCENE};
 use common::{gpu, render_cpu, render_gpu, PathAgreement};
 use glint::cpu::core::rng::{Rng, SAMPLER_SOBOL};
 use glint::cpu::integrator::renderer::CpuRenderer;
@@ -39,19 +39,6 @@ fn gpu_and_cpu_sobol_draws_agree_bit_for_bit() {
         );
     }
 }
-
-const PROBE_SCENE: &str = r#"
-[camera]
-eye = [0.0, 0.0, -5.0]
-target = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-vfov = 40.0
-[render]
-width = 1
-height = 1
-spp = 1
-max_bounces = 1
-"#;
 
 /// One sample, of global index `sample`, per pixel.
 fn render_sample(renderer: &mut dyn Renderer, sample: u32) -> Image {

@@ -35,6 +35,21 @@ pub struct ProbeParams {
     pub _pad2: u32,
 }
 
+/// A one-pixel scene for probes that read none of the scene, and the header of the small
+/// scenes some probes build on it.
+pub const PROBE_SCENE: &str = r#"
+[camera]
+eye = [0.0, 0.0, -5.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+[render]
+width = 1
+height = 1
+spp = 1
+max_bounces = 1
+"#;
+
 pub const PROBE_SOURCE: &str = include_str!("../shaders/probe.wgsl");
 
 pub fn probe_module_source() -> String {
