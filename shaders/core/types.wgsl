@@ -35,7 +35,7 @@ struct Params {
     accumulated_samples: u32,
     // 1: accumulate the denoiser's albedo, normal and depth (aov.wgsl); needs AOVS compiled in.
     aovs: u32,
-    // Firefly clamp: the most a contribution of scattered light may add (0: off; trace.wgsl).
+    // Firefly clamp: the most a contribution of scattered light may add (0: off; path.wgsl).
     radiance_clamp: f32,
     // Meshes (issue 11).
     triangle_count: u32,

@@ -11,7 +11,7 @@
 // draw none of them. One per ray segment: 0 the camera ray, b + 1 the rays that leave vertex b.
 const ALPHA_STREAMS: u32 = 0x80000000u;
 
-// The key of the segment being traced, set by trace.wgsl before each traversal when HAS_ALPHA.
+// The key of the segment being traced, set by path.wgsl before each traversal when HAS_ALPHA.
 // A private variable (per invocation, like the path) rather than an argument threaded through
 // every traversal.
 var<private> alpha_key: u32 = 0u;

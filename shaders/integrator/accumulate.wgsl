@@ -16,7 +16,7 @@ const MERGE_BLOCK: u32 = 64u;
 
 // [0]: samples dropped because they were NaN, infinite or above 1e14 (added once per
 // invocation). [1]: invocations whose loops the driver ended early, which write nothing (see
-// render() in trace.wgsl): the host reports them as an error.
+// render() in path.wgsl): the host reports them as an error.
 @group(0) @binding(16) var<storage, read_write> accumulate_counters: array<atomic<u32>, 2>;
 
 struct Accumulator {

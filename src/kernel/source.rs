@@ -170,8 +170,8 @@ pub const SHADER_PARTS: [(&str, &str); 42] = [
         include_str!("../../shaders/integrator/tiles.wgsl"),
     ),
     (
-        "integrator/trace.wgsl",
-        include_str!("../../shaders/integrator/trace.wgsl"),
+        "integrator/path.wgsl",
+        include_str!("../../shaders/integrator/path.wgsl"),
     ),
 ];
 
@@ -186,10 +186,10 @@ const TRAVERSE_WIDE: &str = include_str!("../../shaders/traverse/wide.wgsl");
 const TRAVERSE_BINARY_ONLY: &str = include_str!("../../shaders/traverse/binary_only.wgsl");
 const SCENE_UNIFORM: &str = include_str!("../../shaders/core/scene_uniform.wgsl");
 
-/// Name of the compute entry point in `shaders/integrator/trace.wgsl`.
+/// Name of the compute entry point in `shaders/integrator/path.wgsl`.
 pub const RENDER_ENTRY_POINT: &str = "render";
 
-/// Workgroup size of the render kernel, as declared in `shaders/integrator/trace.wgsl`.
+/// Workgroup size of the render kernel, as declared in `shaders/integrator/path.wgsl`.
 pub const WORKGROUP_SIZE: (u32, u32) = (8, 8);
 
 /// The WGSL declaring the scene's bindings, as a named part.

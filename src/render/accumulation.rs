@@ -28,7 +28,7 @@ impl Accumulation {
     }
 
     /// Adds `other`'s samples with Chan, Golub and LeVeque's pairwise update, in the kernel's
-    /// f32 arithmetic and operation order (`shaders/integrator/trace.wgsl`, where a batch joins the
+    /// f32 arithmetic and operation order (`shaders/integrator/path.wgsl`, where a batch joins the
     /// totals). So merging the statistics of consecutive sample ranges gives the same bits as
     /// a render whose batches were those ranges. Both must have the same size.
     pub fn merge(&mut self, other: &Accumulation) {

@@ -275,7 +275,7 @@ fn compiled_out_features_do_not_change_the_image() {
         let differing = differing_pixels(&a, &b);
         eprintln!("{name}: {:?}: {differing} pixels differ", features);
         // Not one pixel may differ: the coat's normal is its own value in every variant
-        // (shaders/integrator/trace.wgsl), so none merges the coat's arithmetic with the base's, which
+        // (shaders/integrator/path.wgsl), so none merges the coat's arithmetic with the base's, which
         // the kernel with every feature cannot, and rounds it otherwise (one pixel in 1024
         // parted in the coated pbr scene before).
         assert!(differing == 0, "{name}: {differing} pixels differ");

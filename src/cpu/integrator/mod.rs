@@ -3,6 +3,6 @@
 
 pub mod accumulate;
 pub mod aov;
+pub mod path;
 pub mod renderer;
-pub mod trace;
 pub mod volume;

@@ -1,6 +1,6 @@
 //! The CPU renderer: the kernel's entry point run over all pixels, rows in parallel (rayon).
 
-use crate::cpu::integrator::trace::{render_pixel, PixelStats};
+use crate::cpu::integrator::path::{render_pixel, PixelStats};
 use crate::cpu::scene_refs::SceneRefs;
 use crate::image::aov::Aovs;
 use crate::image::output::Image;

@@ -1,4 +1,4 @@
-// Path tracing kernel (mirror: src/cpu/integrator/trace.rs): one invocation per pixel adds
+// Path tracing kernel (mirror: src/cpu/integrator/path.rs): one invocation per pixel adds
 // params.sample_count samples, starting at global sample index params.sample_start.
 
 // Segments this invocation traced; added to `segments_traced` once at the end.

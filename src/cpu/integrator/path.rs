@@ -1,4 +1,4 @@
-//! Path tracing (WGSL side: `shaders/integrator/trace.wgsl`).
+//! Path tracing (WGSL side: `shaders/integrator/path.wgsl`).
 
 use crate::cpu::core::camera::camera_ray;
 use crate::cpu::core::ray::Ray;
@@ -192,7 +192,7 @@ fn add_escaped_light(scene: &SceneRefs, path: &mut PathState, light_sampling: bo
 /// The material's normal maps at a triangle hit: the base's replaces `hit`'s shading normal;
 /// returns the pbr coat's own shading normal (KHR_materials_clearcoat): its
 /// clearcoatNormalTexture, else the unmapped one, since the base's normal map does not reach
-/// it. That one is normalised again as the kernel does (shaders/integrator/trace.wgsl says
+/// it. That one is normalised again as the kernel does (shaders/integrator/path.wgsl says
 /// why), where there is a coat: nothing else reads it.
 fn apply_normal_maps(scene: &SceneRefs, m: &Material, hit: &mut Hit, wo: Vec3) -> Vec3 {
     let mut coat_normal = hit.shading_normal;
