@@ -52,7 +52,18 @@ struct Params {
     projection: u32,
     // SAMPLER_INDEPENDENT or SAMPLER_SOBOL (rng.wgsl).
     sampler: u32,
+    // INTEGRATOR_PATH or INTEGRATOR_BDPT (integrator/).
+    integrator: u32,
+    // Fixed-point scale of the splat film (splat.wgsl).
+    splat_scale: f32,
+    // A sphere around every surface and light: where the light paths of the environment map
+    // and the suns start (emission.wgsl).
+    scene_center: vec3<f32>,
+    scene_radius: f32,
 }
+
+const INTEGRATOR_PATH: u32 = 0u;
+const INTEGRATOR_BDPT: u32 = 1u;
 
 // Params.projection: camera rays from the eye (or the lens) through the image plane, or
 // parallel ones along `forward` from the image plane through the eye.

@@ -18,7 +18,9 @@ use crate::render::{
 };
 use crate::scene::model::ModelScene;
 use crate::scene::model_toml::model_toml;
-use crate::scene::{RenderOverrides, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP};
+use crate::scene::{
+    Integrator, RenderOverrides, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+};
 use anyhow::Result;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -59,6 +61,10 @@ pub struct RenderArgs {
     /// independent): independent numbers, or Owen-scrambled Sobol points (lower error).
     #[arg(long, value_enum)]
     pub sampler: Option<Sampler>,
+    /// The light transport estimator (overrides [render] integrator; default path): path
+    /// tracing, or bidirectional path tracing (caustics).
+    #[arg(long, value_enum)]
+    pub integrator: Option<Integrator>,
     /// Render on the CPU reference.
     #[arg(long, conflicts_with = "gpu")]
     pub cpu: bool,
@@ -135,8 +141,12 @@ fn parse_target_error(s: &str) -> Result<f64, String> {
 }
 
 /// Either a GPU renderer or, where there is none, the CPU reference.
-fn open_gpu(args: &RenderArgs) -> Result<Option<GpuContext>> {
+fn open_gpu(args: &RenderArgs, integrator: Integrator) -> Result<Option<GpuContext>> {
     if args.cpu {
+        return Ok(None);
+    }
+    if integrator == Integrator::Bdpt && !args.gpu {
+        // Not in the kernel yet: the CPU reference renders it.
         return Ok(None);
     }
     match GpuContext::new() {
@@ -182,6 +192,7 @@ fn scene_to_render(args: &RenderArgs) -> Result<Option<Scene>> {
         seed: args.seed,
         light_sampling: args.light_sampling,
         sampler: args.sampler,
+        integrator: args.integrator,
     };
     let scene = scene
         .with_overrides(&overrides)
@@ -248,6 +259,7 @@ fn json_summary(
         "max_bounces": run.scene.render.max_bounces,
         "seed": run.scene.render.seed,
         "sampler": run.scene.render.sampler.name(),
+        "integrator": run.scene.render.integrator.name(),
         "paths": paths,
         "seconds": seconds,
         "paths_per_second": paths as f64 / seconds.max(1e-9),
@@ -316,7 +328,17 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     args.post.check()?;
 
-    let gpu = open_gpu(&args)?;
+    if scene.render.integrator == Integrator::Bdpt
+        && (args.variance.is_some() || args.target_error.is_some())
+    {
+        // Splats break the per-pixel independence the variance image rests on; batch means
+        // would estimate it, and are not built yet.
+        return Err(InputError(
+            "--variance and --target-error are not available with the bdpt integrator yet (its splats make pixels depend on one another)".into(),
+        )
+        .into());
+    }
+    let gpu = open_gpu(&args, scene.render.integrator)?;
     let (mut renderer, traversal) = make_renderer(&args, gpu.as_ref(), &kernel_scene)?;
 
     plan.start(renderer.as_mut())?;

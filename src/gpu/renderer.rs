@@ -140,6 +140,11 @@ impl<'a> GpuRenderer<'a> {
         variant: KernelVariant,
         window_bytes: u64,
     ) -> Result<GpuRenderer<'a>> {
+        if scene.params.integrator == crate::kernel::types::INTEGRATOR_BDPT {
+            return Err(anyhow!(
+                "the bdpt integrator runs on the CPU reference only so far (render with --cpu)"
+            ));
+        }
         if !variant.features.covers(&KernelFeatures::of(scene)) {
             return Err(anyhow!(
                 "the kernel variant {variant:?} lacks features the scene uses"
@@ -509,6 +514,8 @@ impl Renderer for GpuRenderer<'_> {
             count: self.samples,
             mean: self.read_vec3s(&self.images.mean)?,
             m2: self.read_vec3s(&self.images.m2)?,
+            splats: Vec::new(),
+            splat_scale: 0.0,
         })
     }
 

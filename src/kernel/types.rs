@@ -57,8 +57,20 @@ pub struct Params {
     pub projection: u32,
     /// `SAMPLER_INDEPENDENT` or `SAMPLER_SOBOL` (`src/cpu/core/rng.rs`).
     pub sampler: u32,
-    pub _pad: [u32; 2],
+    /// `INTEGRATOR_PATH` or `INTEGRATOR_BDPT` (`src/cpu/integrator/`).
+    pub integrator: u32,
+    /// Fixed-point scale of the splat film (`src/cpu/integrator/splat.rs`).
+    pub splat_scale: f32,
+    /// A sphere around every surface and light: where the light paths of the environment map
+    /// and the suns start (a disk of this radius facing the light, `src/cpu/lights/emission.rs`).
+    pub scene_center: [f32; 3],
+    pub scene_radius: f32,
 }
+
+/// `Params::integrator`: unidirectional path tracing with next-event estimation.
+pub const INTEGRATOR_PATH: u32 = 0;
+/// `Params::integrator`: bidirectional path tracing (`src/cpu/integrator/bdpt/`).
+pub const INTEGRATOR_BDPT: u32 = 1;
 
 /// `Params::roulette_start` that turns Russian roulette off.
 pub const ROULETTE_OFF: u32 = u32::MAX;

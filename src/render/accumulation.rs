@@ -1,6 +1,7 @@
 //! A render's per-pixel running statistics (mean and M2 over a count of samples), as the
 //! renderers keep them and as partial files store them, and the exact pairwise merge of two.
 
+use crate::cpu::integrator::splat::fixed_point_value;
 use crate::image::output::Image;
 
 /// Per-pixel mean radiance and M2 (the sum of squared deviations from the mean) over `count`
@@ -12,6 +13,11 @@ pub struct Accumulation {
     pub count: u32,
     pub mean: Vec<[f32; 3]>,
     pub m2: Vec<[f32; 3]>,
+    /// Bidirectional path tracing's splat film: per pixel and channel a 64-bit fixed-point
+    /// sum at `splat_scale` (`src/cpu/integrator/splat.rs`); empty for path tracing. The
+    /// image adds it divided by `count`.
+    pub splats: Vec<u64>,
+    pub splat_scale: f32,
 }
 
 impl Accumulation {
@@ -24,6 +30,8 @@ impl Accumulation {
             count: 0,
             mean: vec![[0.0; 3]; pixels],
             m2: vec![[0.0; 3]; pixels],
+            splats: Vec::new(),
+            splat_scale: 0.0,
         }
     }
 
@@ -54,13 +62,32 @@ impl Accumulation {
             }
         }
         self.count += other.count;
+        // Splat sums are integers: they add exactly, in any order (wrapping as the kernel's do).
+        if self.splats.is_empty() {
+            self.splats = other.splats.clone();
+            self.splat_scale = other.splat_scale;
+        } else {
+            for (a, b) in self.splats.iter_mut().zip(&other.splats) {
+                *a = a.wrapping_add(*b);
+            }
+        }
     }
 
     pub fn mean_image(&self) -> Image {
+        let mut pixels = self.mean.clone();
+        if !self.splats.is_empty() && self.count > 0 {
+            let n = self.count as f64;
+            for (pixel, rgb) in pixels.iter_mut().enumerate() {
+                for (c, v) in rgb.iter_mut().enumerate() {
+                    let splat = fixed_point_value(self.splats[3 * pixel + c], self.splat_scale);
+                    *v = (*v as f64 + splat / n) as f32;
+                }
+            }
+        }
         Image {
             width: self.width,
             height: self.height,
-            pixels: self.mean.clone(),
+            pixels,
         }
     }
 

@@ -24,6 +24,14 @@ use std::path::Path;
 pub const FORMAT: &str = "glint-partial/1";
 const MEAN_CHANNELS: [&str; 3] = ["R", "G", "B"];
 const M2_CHANNELS: [&str; 3] = ["M2.R", "M2.G", "M2.B"];
+/// Bidirectional renders: the camera strategies' own mean (RGB holds the image, splats
+/// added), and the splat film's 64-bit sums as two 32-bit unsigned words per channel.
+const CAMERA_CHANNELS: [&str; 3] = ["Camera.R", "Camera.G", "Camera.B"];
+const SPLAT_CHANNELS: [[&str; 2]; 3] = [
+    ["Splat.R.high", "Splat.R.low"],
+    ["Splat.G.high", "Splat.G.low"],
+    ["Splat.B.high", "Splat.B.low"],
+];
 
 /// What a partial file says about its samples, besides the pixels.
 #[derive(Clone, Debug, PartialEq)]
@@ -103,17 +111,27 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     // A perspective camera's parameters hash as they did before `projection` (and its padding)
     // joined them, so the settings, and the headers of files rendered with them, stay what they
     // were; an orthographic camera's hash them all, `projection` = 1 included.
+    // The fields after `sampler` (the integrator's, hashed below) replaced 8 bytes of zero
+    // padding, which hash as they did.
     let params_bytes = bytemuck::bytes_of(&params);
-    let params_bytes = if params.projection == PROJECTION_PERSPECTIVE {
-        &params_bytes[..std::mem::offset_of!(Params, projection)]
+    let mut params_bytes = if params.projection == PROJECTION_PERSPECTIVE {
+        params_bytes[..std::mem::offset_of!(Params, projection)].to_vec()
     } else {
-        params_bytes
+        params_bytes[..std::mem::offset_of!(Params, integrator)].to_vec()
     };
-    array("params", params_bytes);
+    if params.projection != PROJECTION_PERSPECTIVE {
+        params_bytes.extend_from_slice(&[0; 8]);
+    }
+    array("params", &params_bytes);
     // The sampler only where it is not the independent one, so earlier hashes stay as they
     // were (a perspective camera's bytes above stop before it).
     if params.sampler != 0 {
         array("sampler", bytemuck::bytes_of(&params.sampler));
+    }
+    // Likewise the integrator, and the splat film's scale that comes with bidirectional.
+    if params.integrator != 0 {
+        array("integrator", bytemuck::bytes_of(&params.integrator));
+        array("splat_scale", bytemuck::bytes_of(&params.splat_scale));
     }
     array("spheres", bytemuck::cast_slice(spheres));
     array("quads", bytemuck::cast_slice(quads));
@@ -198,9 +216,20 @@ impl Partial {
             )
         };
         let mut channels = SmallVec::new();
+        let image = a.mean_image();
         for c in 0..3 {
-            channels.push(channel(MEAN_CHANNELS[c], &a.mean, c));
+            channels.push(channel(MEAN_CHANNELS[c], &image.pixels, c));
             channels.push(channel(M2_CHANNELS[c], &a.m2, c));
+            if !a.splats.is_empty() {
+                channels.push(channel(CAMERA_CHANNELS[c], &a.mean, c));
+                for (w, name) in SPLAT_CHANNELS[c].iter().enumerate() {
+                    let shift = if w == 0 { 32 } else { 0 };
+                    let words = (0..a.mean.len())
+                        .map(|i| (a.splats[3 * i + c] >> shift) as u32)
+                        .collect();
+                    channels.push(AnyChannel::new(*name, FlatSamples::U32(words)));
+                }
+            }
         }
         let info = &self.info;
         let mut attributes = LayerAttributes::default();
@@ -221,6 +250,13 @@ impl Partial {
             ("glint.device", info.device.clone()),
         ] {
             attributes.other.insert(Text::from(key), text(&value));
+        }
+        if !a.splats.is_empty() {
+            // The exact f32, as its bits.
+            let scale = format!("{:08x}", a.splat_scale.to_bits());
+            attributes
+                .other
+                .insert(Text::from("glint.splat_scale"), text(&scale));
         }
         let layer = Layer::new(
             (a.width as usize, a.height as usize),
@@ -352,12 +388,59 @@ impl Partial {
             }
             Ok(out)
         };
+        let has_splats = layer
+            .channel_data
+            .list
+            .iter()
+            .any(|c| c.name == *CAMERA_CHANNELS[0]);
+        let mut splats = Vec::new();
+        let mut splat_scale = 0.0;
+        if has_splats {
+            let word = |name: &str| -> Result<&[u32], String> {
+                let found = layer
+                    .channel_data
+                    .list
+                    .iter()
+                    .find(|c| c.name == *name)
+                    .ok_or_else(|| fail(format!("the channel {name} is missing")))?;
+                match &found.sample_data {
+                    FlatSamples::U32(v) if v.len() == pixels => Ok(v),
+                    _ => Err(fail(format!(
+                        "the channel {name} is not 32-bit unsigned of the image's size"
+                    ))),
+                }
+            };
+            splats = vec![0u64; 3 * pixels];
+            for (c, [high, low]) in SPLAT_CHANNELS.iter().enumerate() {
+                let (high, low) = (word(high)?, word(low)?);
+                for i in 0..pixels {
+                    splats[3 * i + c] = ((high[i] as u64) << 32) | low[i] as u64;
+                }
+            }
+            let bits = text_attribute(&layer.attributes.other, "glint.splat_scale")
+                .and_then(|s| u32::from_str_radix(&s, 16).ok())
+                .ok_or_else(|| {
+                    fail("the attribute glint.splat_scale is missing or not hex".into())
+                })?;
+            splat_scale = f32::from_bits(bits);
+            if !(splat_scale.is_finite() && splat_scale > 0.0) {
+                return Err(fail(
+                    "the attribute glint.splat_scale is not a positive number".into(),
+                ));
+            }
+        }
         let accumulation = Accumulation {
             width: width as u32,
             height: height as u32,
             count,
-            mean: gather(MEAN_CHANNELS)?,
+            mean: gather(if has_splats {
+                CAMERA_CHANNELS
+            } else {
+                MEAN_CHANNELS
+            })?,
             m2: gather(M2_CHANNELS)?,
+            splats,
+            splat_scale,
         };
         Ok(Partial { info, accumulation })
     }

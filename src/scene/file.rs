@@ -100,6 +100,7 @@ pub(super) struct RenderToml {
     pub(super) light_sampling: Option<bool>,
     pub(super) russian_roulette: Option<bool>,
     pub(super) sampler: Option<S<String>>,
+    pub(super) integrator: Option<S<String>>,
 }
 
 #[derive(Deserialize)]

@@ -203,6 +203,44 @@ pub struct RenderSettings {
     pub russian_roulette: bool,
     /// Where a path's random numbers come from.
     pub sampler: Sampler,
+    /// Which estimator renders the image.
+    pub integrator: Integrator,
+}
+
+/// `[render] integrator`, `--integrator`: the light transport estimator.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Integrator {
+    /// Unidirectional path tracing with next-event estimation and MIS.
+    #[default]
+    Path,
+    /// Bidirectional path tracing: every join of a camera and a light subpath, weighted by the
+    /// power heuristic; finds caustics that path tracing cannot.
+    Bdpt,
+}
+
+impl Integrator {
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::Path => "path",
+            Integrator::Bdpt => "bdpt",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Integrator> {
+        match name {
+            "path" => Some(Integrator::Path),
+            "bdpt" => Some(Integrator::Bdpt),
+            _ => None,
+        }
+    }
+
+    /// `Params::integrator`.
+    pub fn kernel_value(self) -> u32 {
+        match self {
+            Integrator::Path => crate::kernel::types::INTEGRATOR_PATH,
+            Integrator::Bdpt => crate::kernel::types::INTEGRATOR_BDPT,
+        }
+    }
 }
 
 /// `[render] sampler`, `--sampler`: the numbers each sample's decisions draw.
@@ -419,6 +457,7 @@ pub struct RenderOverrides {
     pub seed: Option<u32>,
     pub light_sampling: Option<bool>,
     pub sampler: Option<Sampler>,
+    pub integrator: Option<Integrator>,
 }
 
 impl Scene {
@@ -498,12 +537,27 @@ impl Scene {
         r.seed = o.seed.unwrap_or(r.seed);
         r.light_sampling = o.light_sampling.unwrap_or(r.light_sampling);
         r.sampler = o.sampler.unwrap_or(r.sampler);
+        r.integrator = o.integrator.unwrap_or(r.integrator);
         check_image_size(r.width as i64, r.height as i64)?;
         check_range(r.spp as i64, 1, MAX_SPP as i64).map_err(|m| format!("spp {m}"))?;
         check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)
             .map_err(|m| format!("max_bounces {m}"))?;
+        check_integrator_bounces(r)?;
         Ok(self)
     }
+}
+
+/// Bidirectional subpaths live in fixed arrays (`src/cpu/integrator/bdpt/walk.rs`): their
+/// length is bounded.
+pub(crate) fn check_integrator_bounces(r: &RenderSettings) -> Result<(), String> {
+    let limit = crate::cpu::integrator::bdpt::walk::BDPT_MAX_BOUNCES;
+    if r.integrator == Integrator::Bdpt && r.max_bounces > limit {
+        return Err(format!(
+            "max_bounces {} is above {limit}, the most the bdpt integrator traces",
+            r.max_bounces
+        ));
+    }
+    Ok(())
 }
 
 pub(crate) fn check_range(value: i64, min: i64, max: i64) -> Result<(), String> {

@@ -221,6 +221,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
             light_sampling: true,
             russian_roulette: true,
             sampler: Default::default(),
+            integrator: Default::default(),
         },
         materials,
         spheres: Vec::new(),

@@ -48,6 +48,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             light_sampling: true,
             russian_roulette: true,
             sampler: Default::default(),
+            integrator: Default::default(),
         },
         materials: vec![Material {
             name: "m".into(),

@@ -118,7 +118,11 @@ fn rust_structs_match_wgsl_layout() {
             environment_light_probability,
             light_count,
             projection,
-            sampler
+            sampler,
+            integrator,
+            splat_scale,
+            scene_center,
+            scene_radius
         ]
     );
     assert_same_layout!(

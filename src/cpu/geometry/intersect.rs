@@ -20,9 +20,13 @@ use crate::cpu::geometry::triangle::{
     triangle_barycentrics, triangle_normal, triangle_ray, triangle_surface_point,
 };
 use crate::cpu::textures::texture::{both_sets, sphere_uv, triangle_uv};
-use crate::cpu::traverse::bvh::{bvh_closest_primitive, bvh_escapes, bvh_first_hit_is};
+use crate::cpu::traverse::bvh::{
+    bvh_closest_primitive, bvh_escapes, bvh_first_hit_is, bvh_traverse,
+};
+use crate::cpu::traverse::bvh_ray::bvh_ray;
 use crate::kernel::types::{
-    NO_INSTANCE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    NO_INSTANCE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_KIND_SHIFT, PRIMITIVE_QUAD, PRIMITIVE_SPHERE,
+    PRIMITIVE_TRIANGLE,
 };
 use glam::{Vec2, Vec3, Vec4};
 
@@ -110,6 +114,16 @@ pub fn escapes(geometry: &Geometry, ray: &Ray) -> bool {
         return bvh_escapes(geometry, ray);
     }
     closest_primitive(geometry, ray).t == NO_HIT
+}
+
+/// Whether nothing lies along `ray` before distance `t_max` (a shadow ray to a point).
+pub fn unoccluded_before(geometry: &Geometry, ray: &Ray, t_max: f32) -> bool {
+    if !geometry.bvh_nodes.is_empty() {
+        // Any hit nearer than t_max ends the search (a target no primitive matches).
+        let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
+        return bvh_traverse(geometry, &bvh_ray(ray), t_max, t_max, 0, no_target).t == NO_HIT;
+    }
+    closest_primitive(geometry, ray).t >= t_max
 }
 
 /// The nearest hit of `ray` among all primitives; `t == NO_HIT` when there is none.

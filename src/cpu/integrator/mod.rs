@@ -3,6 +3,9 @@
 
 pub mod accumulate;
 pub mod aov;
+pub mod bdpt;
 pub mod path;
+pub mod pixel;
 pub mod renderer;
+pub mod splat;
 pub mod volume;

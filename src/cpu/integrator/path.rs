@@ -7,10 +7,7 @@ use crate::cpu::geometry::alpha::alpha_segment_key;
 use crate::cpu::geometry::hit::{Hit, NO_HIT};
 use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene};
 use crate::cpu::geometry::surface::offset_ray_origin;
-use crate::cpu::integrator::accumulate::{accumulator_start, add_sample, merge_block};
-use crate::cpu::integrator::aov::{
-    aov_mean_add, aov_merge, aov_record_hit, aov_record_miss, aov_start, aovs_on, AovMean, PathAov,
-};
+use crate::cpu::integrator::aov::{aov_record_hit, aov_record_miss, aov_start, aovs_on, PathAov};
 use crate::cpu::integrator::volume::volume_transmittance;
 use crate::cpu::lights::environment::environment_radiance;
 use crate::cpu::lights::light_sample::{nee_weight, power_heuristic, LightSample};
@@ -194,7 +191,7 @@ fn add_escaped_light(scene: &SceneRefs, path: &mut PathState, light_sampling: bo
 /// clearcoatNormalTexture, else the unmapped one, since the base's normal map does not reach
 /// it. That one is normalised again as the kernel does (shaders/integrator/path.wgsl says
 /// why), where there is a coat: nothing else reads it.
-fn apply_normal_maps(scene: &SceneRefs, m: &Material, hit: &mut Hit, wo: Vec3) -> Vec3 {
+pub fn apply_normal_maps(scene: &SceneRefs, m: &Material, hit: &mut Hit, wo: Vec3) -> Vec3 {
     let mut coat_normal = hit.shading_normal;
     if m.clearcoat > 0.0 {
         coat_normal = coat_normal.normalize();
@@ -406,45 +403,4 @@ pub fn trace_path(
     let mut path = start_path(scene.params, pixel, px, py, sample);
     while !path_step(scene, &mut path, pixel, sample, segments) {}
     path
-}
-
-/// Running per-pixel statistics: the mean radiance and M2, the sum of squared deviations.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelStats {
-    pub mean: Vec3,
-    pub m2: Vec3,
-    /// Samples dropped as NaN, infinite or too large (`shaders/integrator/accumulate.wgsl`).
-    pub nonfinite: u32,
-    /// Mean albedo, normal and depth, when `params.aovs` asks for them.
-    pub aov: AovMean,
-}
-
-/// The kernel's entry point for one pixel: `params.sample_count` samples starting at
-/// `params.sample_start`, merged into `stats`, which holds the `params.accumulated_samples`
-/// samples before them. Returns the ray segments traced. (The kernel interleaves its samples' segments
-/// for SIMD efficiency; each sample's result is the same, and they finish in the same order.)
-pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
-    let params = scene.params;
-    let pixel = py * params.width + px;
-    let mut acc = accumulator_start(params.accumulated_samples, stats.mean, stats.m2);
-    let mut aov_mean = AovMean::default();
-    let mut segments = 0;
-    for i in 0..params.sample_count {
-        let sample = params.sample_start + i;
-        let path = trace_path(scene, pixel, px, py, sample, &mut segments);
-        add_sample(&mut acc, path.radiance, sample);
-        if aovs_on(params) {
-            aov_mean_add(&mut aov_mean, &path.aov, i);
-        }
-    }
-    // A batch ended inside a block (the render loop avoids this) keeps the statistics right.
-    merge_block(&mut acc);
-    stats.mean = acc.mean;
-    stats.m2 = acc.m2;
-    stats.nonfinite += acc.nonfinite;
-    if aovs_on(params) {
-        let n_old = params.accumulated_samples as f32;
-        aov_merge(&mut stats.aov, &aov_mean, n_old, params.sample_count as f32);
-    }
-    segments
 }

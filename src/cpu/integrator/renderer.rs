@@ -1,9 +1,11 @@
 //! The CPU renderer: the kernel's entry point run over all pixels, rows in parallel (rayon).
 
-use crate::cpu::integrator::path::{render_pixel, PixelStats};
+use crate::cpu::integrator::pixel::{render_pixel, PixelStats};
+use crate::cpu::integrator::splat::SplatFilm;
 use crate::cpu::scene_refs::SceneRefs;
 use crate::image::aov::Aovs;
 use crate::image::output::Image;
+use crate::kernel::types::INTEGRATOR_BDPT;
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
 use crate::render::accumulation::Accumulation;
@@ -14,6 +16,8 @@ use rayon::prelude::*;
 pub struct CpuRenderer {
     scene: KernelScene,
     stats: Vec<PixelStats>,
+    /// Light tracing's splats (bidirectional path tracing only).
+    film: SplatFilm,
     samples: u32,
     first_sample: u32,
     segments: u64,
@@ -25,6 +29,7 @@ impl CpuRenderer {
         CpuRenderer {
             scene: scene.clone(),
             stats: vec![PixelStats::default(); pixels],
+            film: SplatFilm::new(pixels),
             samples: 0,
             first_sample: 0,
             segments: 0,
@@ -48,6 +53,7 @@ impl Renderer for CpuRenderer {
         params.sample_count = count;
         let refs = SceneRefs::of(&self.scene, &params);
         let width = params.width as usize;
+        let film = &self.film;
         let segments: u64 = self
             .stats
             .par_chunks_mut(width)
@@ -55,7 +61,7 @@ impl Renderer for CpuRenderer {
             .map(|(y, row)| {
                 let mut segments = 0u64;
                 for (x, stats) in row.iter_mut().enumerate() {
-                    segments += render_pixel(&refs, x as u32, y as u32, stats) as u64;
+                    segments += render_pixel(&refs, x as u32, y as u32, stats, film) as u64;
                 }
                 segments
             })
@@ -80,6 +86,12 @@ impl Renderer for CpuRenderer {
             count: self.samples,
             mean: self.stats.iter().map(|s| s.mean.into()).collect(),
             m2: self.stats.iter().map(|s| s.m2.into()).collect(),
+            splats: if self.scene.params.integrator == INTEGRATOR_BDPT {
+                self.film.words()
+            } else {
+                Vec::new()
+            },
+            splat_scale: self.scene.params.splat_scale,
         })
     }
 
@@ -92,13 +104,14 @@ impl Renderer for CpuRenderer {
                 stats.m2 = (*m2).into();
             }
             self.samples = state.count;
+            self.film.load(&state.splats);
         }
         self.first_sample = first_sample;
         Ok(())
     }
 
     fn read_mean(&mut self) -> Result<Image> {
-        Ok(self.image(|s| s.mean.into()))
+        Ok(self.read_accumulation()?.mean_image())
     }
 
     fn read_variance(&mut self) -> Result<Image> {
@@ -128,6 +141,7 @@ impl Renderer for CpuRenderer {
 
     fn reset(&mut self) -> Result<()> {
         self.stats.fill(PixelStats::default());
+        self.film.clear();
         self.samples = 0;
         self.segments = 0;
         Ok(())

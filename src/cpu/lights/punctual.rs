@@ -7,14 +7,10 @@
 
 use crate::cpu::core::frame::{basis, PI};
 use crate::cpu::core::ray::Ray;
-use crate::cpu::geometry::intersect::{closest_primitive, escapes};
+use crate::cpu::geometry::intersect::{escapes, unoccluded_before};
 use crate::cpu::lights::light_sample::{power_heuristic, LightSample};
 use crate::cpu::scene_refs::SceneRefs;
-use crate::cpu::traverse::bvh::bvh_traverse;
-use crate::cpu::traverse::bvh_ray::bvh_ray;
-use crate::kernel::types::{
-    Light, LIGHT_SUN, PRIMITIVE_ENVIRONMENT, PRIMITIVE_KIND_SHIFT, PRIMITIVE_LIGHT,
-};
+use crate::kernel::types::{Light, LIGHT_SUN, PRIMITIVE_LIGHT};
 use glam::Vec3;
 
 /// glTF's spot falloff towards the unit direction `from_light` (light → point):
@@ -94,13 +90,7 @@ pub fn punctual_visible(scene: &SceneRefs, shadow: &Ray, light: &LightSample) ->
         return escapes(geometry, shadow);
     }
     let t_light = (Vec3::from(l.position) - shadow.origin).dot(shadow.dir);
-    if !geometry.bvh_nodes.is_empty() {
-        // Any hit nearer than the light ends the search (a target no primitive matches).
-        let no_target = PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT;
-        return bvh_traverse(geometry, &bvh_ray(shadow), t_light, t_light, 0, no_target).t
-            == crate::cpu::geometry::hit::NO_HIT;
-    }
-    closest_primitive(geometry, shadow).t >= t_light
+    unoccluded_before(geometry, shadow, t_light)
 }
 
 /// Radiance of the sun disks a ray escaping along `dir` looks into. With `mis`, each is

@@ -125,6 +125,23 @@ impl Scene {
     /// Points whose bounds hold the scene, for [`environment::scene_radius`]: the spheres'
     /// boxes' corners, the quads' and triangles' corners, the instanced meshes' placed boxes'
     /// corners, and the point and spot lights' positions.
+    /// The centre and radius of a sphere around every surface and light (the box's, as
+    /// `environment::scene_radius` measures it): where light paths from infinitely far
+    /// lights start.
+    pub(super) fn bounding_sphere(&self) -> ([f32; 3], f32) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in self.bounding_points() {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        if lo.x > hi.x {
+            return ([0.0; 3], 1.0);
+        }
+        let radius = environment::scene_radius([lo, hi].into_iter()) as f32;
+        ((0.5 * (lo + hi)).into(), radius)
+    }
+
     fn bounding_points(&self) -> impl Iterator<Item = Vec3> + '_ {
         self.spheres
             .iter()

@@ -189,6 +189,7 @@ impl Scene {
                 .collect(),
             instances: Vec::new(),
         };
+        scene.params.splat_scale = params::splat_scale(&scene);
         self.lay_out_bvh(&mut scene)?;
         Ok(scene)
     }

@@ -80,9 +80,51 @@ impl Scene {
                 .map_or(0.0, |e| e.probability),
             light_count: self.lights.len() as u32,
             sampler: r.sampler.kernel_value(),
+            integrator: r.integrator.kernel_value(),
             ..Default::default()
         };
+        (params.scene_center, params.scene_radius) = self.bounding_sphere();
         place_camera(&mut params, &self.camera);
         params
     }
+}
+
+/// The splat film's fixed-point scale (`src/cpu/integrator/splat.rs`): 2²⁴ units per the
+/// scene's brightest radiance, that of its brightest emitter (area emitters and the
+/// environment map's mean by their radiance, point lights by their intensity at the scene's
+/// radius, suns by their irradiance over π). Pixels rarely exceed it, so a splat keeps some
+/// 2²⁴ steps of resolution, and a pixel's sum has room for 2⁴⁰ times it.
+pub fn splat_scale(scene: &super::KernelScene) -> f32 {
+    let peak = |v: [f32; 3]| v[0].max(v[1]).max(v[2]);
+    let radius = scene.params.scene_radius.max(1e-6);
+    let mut brightest = peak(scene.params.background);
+    for m in &scene.materials {
+        brightest = brightest.max(peak(m.emission));
+    }
+    for l in &scene.lights {
+        let per = if l.kind == crate::kernel::types::LIGHT_SUN {
+            if l.sun_one_minus_cos > 0.0 {
+                1.0
+            } else {
+                1.0 / std::f32::consts::PI
+            }
+        } else {
+            1.0 / (radius * radius)
+        };
+        brightest = brightest.max(peak(l.emitted) * per);
+    }
+    if !scene.environment_texels.is_empty() {
+        let n = scene.environment_texels.len() as f64;
+        let mean: f64 = scene
+            .environment_texels
+            .iter()
+            .map(|t| peak(t.radiance) as f64)
+            .sum::<f64>()
+            / n;
+        brightest = brightest.max(mean as f32);
+    }
+    if !(brightest.is_finite() && brightest > 0.0) {
+        brightest = 1.0;
+    }
+    16_777_216.0 / brightest
 }

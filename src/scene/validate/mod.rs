@@ -13,7 +13,8 @@ pub(super) use fields::FieldError;
 
 use super::file::{RenderToml, SceneToml};
 use super::{
-    check_image_size, RenderSettings, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+    check_image_size, check_integrator_bounces, Integrator, RenderSettings, Sampler, Scene,
+    MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
 };
 use fields::{fail, int_in, non_negative, radiance_in_range};
 use glam::Vec3;
@@ -146,7 +147,21 @@ fn validate_render(
         },
         None => Sampler::default(),
     };
-    Ok(RenderSettings {
+    let integrator = match &render.integrator {
+        Some(s) => match Integrator::from_name(s.get_ref()) {
+            Some(integrator) => integrator,
+            None => fail(
+                s.span(),
+                "render.integrator",
+                format!(
+                    "unknown integrator {:?}; known: \"path\", \"bdpt\"",
+                    s.get_ref()
+                ),
+            )?,
+        },
+        None => Integrator::default(),
+    };
+    let settings = RenderSettings {
         width: width as u32,
         height: height as u32,
         spp,
@@ -156,5 +171,10 @@ fn validate_render(
         light_sampling: render.light_sampling.unwrap_or(true),
         russian_roulette: render.russian_roulette.unwrap_or(true),
         sampler,
-    })
+        integrator,
+    };
+    if let Err(message) = check_integrator_bounces(&settings) {
+        fail(render.max_bounces.span(), "render.max_bounces", message)?;
+    }
+    Ok(settings)
 }
