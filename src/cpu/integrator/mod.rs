@@ -4,5 +4,6 @@
 pub mod accumulate;
 pub mod aov;
 pub mod path;
+pub mod path_media;
 pub mod renderer;
 pub mod volume;
