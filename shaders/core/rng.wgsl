@@ -8,12 +8,22 @@
 const PURPOSE_BSDF: u32 = 0u;
 const PURPOSE_LIGHT: u32 = 1u;
 const PURPOSE_ROULETTE: u32 = 2u;
+// Participating media (media/): a segment's free flight, a medium vertex's phase sampling and
+// its next-event estimation.
+const PURPOSE_FREE_FLIGHT: u32 = 3u;
+const PURPOSE_PHASE: u32 = 4u;
+const PURPOSE_MEDIUM_LIGHT: u32 = 5u;
 
 const SAMPLER_INDEPENDENT: u32 = 0u;
 const SAMPLER_SOBOL: u32 = 1u;
 
 fn stream_id(bounce: u32, purpose: u32) -> u32 {
-    return 1u + 3u * bounce + purpose;
+    if purpose < 3u {
+        return 1u + 3u * bounce + purpose;
+    }
+    // Later purposes get a range of their own (above any 1 + 3 bounce), so that the first
+    // three keep their streams and media-free images their pixels.
+    return 0x80000000u + 8u * bounce + purpose;
 }
 
 fn pcg_hash(v: u32) -> u32 {

@@ -60,6 +60,23 @@ struct Params {
     // and the suns start (emission.wgsl).
     scene_center: vec3<f32>,
     scene_radius: f32,
+    // Participating media (media/medium.wgsl): the slots of `media` in use (0: none), the
+    // slot filling the scene and the one the camera starts in besides it (NO_MEDIUM: none).
+    medium_count: u32,
+    global_medium: u32,
+    camera_medium: u32,
+    media: array<Medium, 8>,
+}
+
+const NO_MEDIUM: u32 = 0xffffffffu;
+
+// A homogeneous medium (src/kernel/types.rs): extinction and scattering per unit length,
+// Henyey-Greenstein's g, and the material whose objects bound it, or NO_MEDIUM.
+struct Medium {
+    sigma_t: vec3<f32>,
+    g: f32,
+    sigma_s: vec3<f32>,
+    boundary: u32,
 }
 
 const INTEGRATOR_PATH: u32 = 0u;

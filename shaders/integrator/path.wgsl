@@ -17,6 +17,8 @@ struct PathState {
     came_from_delta: bool,
     // Albedo, normal and depth for the denoiser (aov.wgsl); untouched unless AOVS.
     aov: PathAov,
+    // The participating media the ray is in (media/medium.wgsl); empty without media.
+    media: MediumStack,
 }
 
 // Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
@@ -34,7 +36,7 @@ fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let ray = camera_ray(px, py, jitter, lens);
-    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true, aov_start());
+    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true, aov_start(), medium_start());
 }
 
 // Traces one segment of the path (and its shadow ray); true when the path has ended.
@@ -49,6 +51,15 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     }
     var hit = intersect_scene(ray);
     segments += 1u;
+    if HAS_MEDIA {
+        let flight = free_flight(path, hit.t, pixel, sample);
+        if flight.scattered {
+            return medium_vertex(path, ray.origin + flight.t * ray.dir, light_sampling, pixel, sample);
+        }
+        if all((*path).throughput == vec3<f32>(0.0)) {
+            return true;
+        }
+    }
     if hit.t == NO_HIT {
         add_escaped_light(path, light_sampling);
         return true;
@@ -66,6 +77,9 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
     // max_bounces counts scattering events; this also bounds every path's length.
     if bounce >= params.max_bounces {
         return true;
+    }
+    if HAS_MEDIA && is_interface(m) {
+        return cross_interface(path, hit);
     }
     let origin = offset_ray_origin(hit.position, hit.error, hit.normal);
     if light_sampling && !is_delta(m) {
@@ -190,10 +204,21 @@ fn add_unblocked_light(
     if dot(light.dir, hit.normal) < 0.0 {
         shadow_origin = offset_ray_origin(hit.position, hit.error, -hit.normal);
     }
-    if light_visible(Ray(shadow_origin, light.dir), light) {
+    // Through participating media the light arrives attenuated, through interfaces too.
+    var through = vec3<f32>(0.0);
+    if HAS_MEDIA {
+        var media = (*path).media;
+        if dot(light.dir, hit.normal) < 0.0 {
+            media = medium_crossed(media, hit.material, hit.front_face);
+        }
+        through = shadow_transmittance(Ray(shadow_origin, light.dir), light, media);
+    } else if light_visible(Ray(shadow_origin, light.dir), light) {
+        through = vec3<f32>(1.0);
+    }
+    if any(through > vec3<f32>(0.0)) {
         let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
         let weight = nee_weight(light, pdf);
-        let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf);
+        let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf) * through;
         (*path).radiance += firefly_clamp(contribution, bounce + 1u);
     }
 }
@@ -235,6 +260,10 @@ fn scatter(
     (*path).ray = Ray(offset_ray_origin(p, hit.error, side), s.dir);
     (*path).ray_start = p;
     (*path).bounce = bounce + 1u;
+    // A direction through the surface enters or leaves the medium it bounds.
+    if HAS_MEDIA && dot(s.dir, hit.normal) < 0.0 {
+        (*path).media = medium_crossed((*path).media, hit.material, hit.front_face);
+    }
     return false;
 }
 

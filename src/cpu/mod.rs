@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod integrator;
 pub mod lights;
 pub mod materials;
+pub mod media;
 pub mod scene_refs;
 pub mod textures;
 pub mod traverse;

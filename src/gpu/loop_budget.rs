@@ -76,6 +76,14 @@ pub fn hardware_loop_iterations_per_sample(scene: &KernelScene) -> u64 {
 
 fn sample_iterations(params: &Params, per_ray: u64) -> u64 {
     let segments = params.max_bounces as u64 + 1;
+    if params.medium_count > 0 {
+        // Media (shaders/media/medium.wgsl): a shadow ray casts one ray per interface it
+        // crosses, and each crossing looks its medium up among the slots and the stack.
+        let crossings = crate::cpu::media::medium::MAX_SHADOW_CROSSINGS as u64;
+        let media_loops = 8 + 4 * 4;
+        return segments
+            * ((1 + crossings) * (per_ray + media_loops) + params.light_count as u64 + 1);
+    }
     segments * (2 * per_ray + params.light_count as u64 + 1)
 }
 

@@ -7,7 +7,7 @@ use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 42] = [
+pub const SHADER_PARTS: [(&str, &str); 45] = [
     (
         "core/types.wgsl",
         include_str!("../../shaders/core/types.wgsl"),
@@ -158,6 +158,14 @@ pub const SHADER_PARTS: [(&str, &str); 42] = [
         include_str!("../../shaders/lights/punctual.wgsl"),
     ),
     (
+        "media/phase.wgsl",
+        include_str!("../../shaders/media/phase.wgsl"),
+    ),
+    (
+        "media/medium.wgsl",
+        include_str!("../../shaders/media/medium.wgsl"),
+    ),
+    (
         "integrator/aov.wgsl",
         include_str!("../../shaders/integrator/aov.wgsl"),
     ),
@@ -172,6 +180,10 @@ pub const SHADER_PARTS: [(&str, &str); 42] = [
     (
         "integrator/path.wgsl",
         include_str!("../../shaders/integrator/path.wgsl"),
+    ),
+    (
+        "integrator/path_media.wgsl",
+        include_str!("../../shaders/integrator/path_media.wgsl"),
     ),
 ];
 
@@ -256,7 +268,8 @@ fn features_part(features: &KernelFeatures) -> String {
          const HAS_TEXTURES: bool = {};\nconst HAS_ENVIRONMENT: bool = {};\n\
          const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
          const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
-         const HAS_TEXCOORD_1: bool = {};\nconst HAS_INSTANCES: bool = {};\n",
+         const HAS_TEXCOORD_1: bool = {};\nconst HAS_INSTANCES: bool = {};\n\
+         const HAS_MEDIA: bool = {};\n",
         features.light_sampling,
         features.sphere_emitters,
         features.quad_emitters,
@@ -276,7 +289,8 @@ fn features_part(features: &KernelFeatures) -> String {
         features.alpha,
         features.vertex_colors,
         features.textures && features.texcoord1,
-        features.instances
+        features.instances,
+        features.media
     )
 }
 

@@ -65,6 +65,32 @@ pub struct Params {
     /// and the suns start (a disk of this radius facing the light, `src/cpu/lights/emission.rs`).
     pub scene_center: [f32; 3],
     pub scene_radius: f32,
+    /// Participating media (`src/cpu/media/`): how many of `media` are used (0: none, and the
+    /// kernel compiles media out), the slot of the medium filling the scene and the slot the
+    /// camera starts in besides it, each [`NO_MEDIUM`] where there is none.
+    pub medium_count: u32,
+    pub global_medium: u32,
+    pub camera_medium: u32,
+    pub _pad: u32,
+    pub media: [Medium; MAX_MEDIUM_SLOTS],
+}
+
+/// The media's slots in `Params` (`crate::scene::medium::MAX_MEDIUM_SLOTS`).
+pub const MAX_MEDIUM_SLOTS: usize = crate::scene::medium::MAX_MEDIUM_SLOTS;
+
+/// `Params::global_medium` and `camera_medium`, and `Medium::boundary`: none.
+pub const NO_MEDIUM: u32 = u32::MAX;
+
+/// A homogeneous medium as the kernel reads it (`src/cpu/media/medium.rs`): extinction and
+/// scattering per unit length, Henyey–Greenstein's g, and the material whose objects bound it
+/// (their inside is this medium), or [`NO_MEDIUM`] for the global medium and a camera's.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Medium {
+    pub sigma_t: [f32; 3],
+    pub g: f32,
+    pub sigma_s: [f32; 3],
+    pub boundary: u32,
 }
 
 /// `Params::integrator`: unidirectional path tracing with next-event estimation.

@@ -226,6 +226,9 @@ pub struct KernelFeatures {
     pub instances: bool,
     /// Textures on the second texture coordinate set (glTF's TEXCOORD_1, shaders/textures/texture.wgsl).
     pub texcoord1: bool,
+    /// Participating media (shaders/media/, shaders/integrator/path_media.wgsl): free flights,
+    /// medium vertices, interfaces and shadow rays through them.
+    pub media: bool,
 }
 
 impl KernelFeatures {
@@ -251,6 +254,7 @@ impl KernelFeatures {
         vertex_colors: true,
         instances: true,
         texcoord1: true,
+        media: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -291,6 +295,7 @@ impl KernelFeatures {
             vertex_colors: !scene.triangle_colors.is_empty(),
             instances: !scene.instances.is_empty(),
             texcoord1: !scene.triangle_uvs1.is_empty(),
+            media: scene.params.medium_count > 0,
         }
     }
 
@@ -317,6 +322,7 @@ impl KernelFeatures {
             && needs(self.vertex_colors, other.vertex_colors)
             && needs(self.instances, other.instances)
             && needs(self.texcoord1, other.texcoord1)
+            && needs(self.media, other.media)
     }
 }
 

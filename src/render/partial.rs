@@ -133,6 +133,11 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         array("integrator", bytemuck::bytes_of(&params.integrator));
         array("splat_scale", bytemuck::bytes_of(&params.splat_scale));
     }
+    // And the media, where there are any.
+    if params.medium_count != 0 {
+        let start = std::mem::offset_of!(Params, medium_count);
+        array("media", &bytemuck::bytes_of(&params)[start..]);
+    }
     array("spheres", bytemuck::cast_slice(spheres));
     array("quads", bytemuck::cast_slice(quads));
     array("materials", bytemuck::cast_slice(materials));

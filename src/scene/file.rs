@@ -65,6 +65,22 @@ pub(super) struct SceneToml {
     pub(super) environment: Option<S<EnvironmentToml>>,
     #[serde(default)]
     pub(super) lights: Vec<S<LightToml>>,
+    #[serde(default)]
+    pub(super) media: BTreeMap<String, S<MediumToml>>,
+}
+
+/// `[media.NAME]`: a homogeneous medium, as `sigma_a` and `sigma_s` or as `color` (the
+/// single-scattering albedo) with `density` or `mean_free_path`; `g` is Henyey–Greenstein's.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct MediumToml {
+    pub(super) sigma_a: Option<S<Triple>>,
+    pub(super) sigma_s: Option<S<Triple>>,
+    pub(super) color: Option<S<Triple>>,
+    pub(super) density: Option<S<Real>>,
+    /// A number, or three (one per channel).
+    pub(super) mean_free_path: Option<S<toml::Value>>,
+    pub(super) g: Option<S<Real>>,
 }
 
 #[derive(Deserialize)]
@@ -86,6 +102,8 @@ pub(super) struct CameraToml {
     pub(super) index: Option<S<i64>>,
     pub(super) aperture: Option<S<Real>>,
     pub(super) focus_distance: Option<S<Real>>,
+    /// The medium the camera is in (default: `[render] medium`).
+    pub(super) medium: Option<S<String>>,
 }
 
 #[derive(Deserialize)]
@@ -101,6 +119,8 @@ pub(super) struct RenderToml {
     pub(super) russian_roulette: Option<bool>,
     pub(super) sampler: Option<S<String>>,
     pub(super) integrator: Option<S<String>>,
+    /// The medium that fills the scene outside every object (fog).
+    pub(super) medium: Option<S<String>>,
 }
 
 #[derive(Deserialize)]
@@ -156,6 +176,8 @@ pub(super) struct SphereToml {
     pub(super) center: S<Triple>,
     pub(super) radius: S<Real>,
     pub(super) material: S<String>,
+    /// The medium that fills the sphere.
+    pub(super) medium: Option<S<String>>,
 }
 
 #[derive(Deserialize)]
@@ -165,6 +187,8 @@ pub(super) struct QuadToml {
     pub(super) u: S<Triple>,
     pub(super) v: S<Triple>,
     pub(super) material: S<String>,
+    /// Refused with a message: a quad bounds no volume.
+    pub(super) medium: Option<S<String>>,
 }
 
 #[derive(Deserialize)]
@@ -183,6 +207,8 @@ pub(super) struct MeshToml {
     /// applied after the mesh's own: any TOML value here, checked in [`super::validate`] where
     /// each instance's index is known for the message.
     pub(super) instances: Option<S<Vec<S<toml::Value>>>>,
+    /// The medium that fills the mesh, which must be closed.
+    pub(super) medium: Option<S<String>>,
 }
 
 /// `scale = 2.0` or `scale = [1.0, 2.0, 1.0]`.

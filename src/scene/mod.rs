@@ -12,6 +12,7 @@ mod file;
 pub mod image;
 pub mod light;
 pub mod limits;
+pub mod medium;
 pub mod mesh;
 pub mod model;
 pub mod model_toml;
@@ -86,6 +87,8 @@ pub struct Scene {
     pub environment: Option<environment::Environment>,
     /// `[[lights]]`: point, spot and directional lights.
     pub lights: Vec<light::Light>,
+    /// Participating media (`[media]`), and where they are.
+    pub media: medium::Media,
 }
 
 /// A mesh placed many times and stored once: the two-level structure's bottom level
@@ -543,6 +546,11 @@ impl Scene {
         check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)
             .map_err(|m| format!("max_bounces {m}"))?;
         check_integrator_bounces(r)?;
+        if r.integrator == Integrator::Bdpt && !self.media.is_empty() {
+            return Err(
+                "the bdpt integrator does not render participating media yet; use \"path\"".into(),
+            );
+        }
         Ok(self)
     }
 }

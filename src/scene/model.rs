@@ -231,6 +231,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
         textures,
         environment: Some(environment),
         lights,
+        media: Default::default(),
     };
     Ok(ModelScene {
         scene,

@@ -73,6 +73,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
         textures: Default::default(),
         environment: None,
         lights: vec![],
+        media: Default::default(),
     };
     scene.kernel_scene().quads[0]
 }

@@ -10,8 +10,8 @@ use glint::kernel::source::{
 use glint::kernel::texels::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use glint::kernel::types::{
     BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
-    Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals, TriangleTangents,
-    TriangleUvs,
+    Medium, Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals,
+    TriangleTangents, TriangleUvs,
 };
 use glint::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding, SceneCounts};
 use naga::proc::Layouter;
@@ -122,9 +122,14 @@ fn rust_structs_match_wgsl_layout() {
             integrator,
             splat_scale,
             scene_center,
-            scene_radius
+            scene_radius,
+            medium_count,
+            global_medium,
+            camera_medium,
+            media
         ]
     );
+    assert_same_layout!(&module, Medium, "Medium", [sigma_t, g, sigma_s, boundary]);
     assert_same_layout!(
         &module,
         Sphere,
@@ -449,6 +454,8 @@ fn every_feature_combination_validates() {
             texcoord1: (bits * 13 / 9) % 2 == 1,
             // Likewise, with and without alpha.
             instances: (bits * 17 / 11) % 2 == 1,
+            // Likewise, with and without light sampling, lights and dielectrics.
+            media: (bits * 19 / 13) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -496,6 +503,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         vertex_colors: false,
         texcoord1: false,
         instances: false,
+        media: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

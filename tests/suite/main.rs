@@ -52,6 +52,7 @@ mod closed_form;
 mod environment;
 mod gpu_vs_cpu;
 mod lights;
+mod media;
 mod sampling;
 mod statistics;
 

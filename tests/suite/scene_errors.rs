@@ -561,3 +561,109 @@ fn sampler_is_named() {
         &["render.sampler", "halton", "independent", "sobol"],
     );
 }
+
+/// `GOOD` with a medium `[media.fog]` given by `fields`, filling the sphere.
+fn with_medium(fields: &str) -> String {
+    edited(
+        "material = \"white\"\n",
+        "material = \"white\"\nmedium = \"fog\"\n",
+    ) + &format!("\n[media.fog]\n{fields}\n")
+}
+
+#[test]
+fn media_with_bad_coefficients_are_named() {
+    for (fields, needles) in [
+        (
+            "sigma_a = [0.1, -0.2, 0.1]\nsigma_s = [1.0, 1.0, 1.0]",
+            &["media.fog.sigma_a", "≥ 0"][..],
+        ),
+        (
+            "sigma_s = [1.0, 1.0]",
+            &["media.fog.sigma_s", "three numbers"],
+        ),
+        (
+            "sigma_s = [1.0, 1.0, 1.0]\ng = 1.0",
+            &["media.fog.g", "(-1, 1)"],
+        ),
+        (
+            "sigma_s = [1.0, 1.0, 1.0]\ng = -1.5",
+            &["media.fog.g", "(-1, 1)"],
+        ),
+        (
+            "color = [0.5, 1.2, 0.5]\ndensity = 1.0",
+            &["media.fog.color", "[0, 1]"],
+        ),
+        ("color = [0.5, 0.5, 0.5]", &["media.fog.density", "missing"]),
+        (
+            "color = [0.5, 0.5, 0.5]\ndensity = -1.0",
+            &["media.fog.density", "got -1"],
+        ),
+        (
+            "color = [0.5, 0.5, 0.5]\nmean_free_path = 0.0",
+            &["media.fog.mean_free_path", "must be in"],
+        ),
+        (
+            "sigma_s = [1.0, 1.0, 1.0]\ndensity = 1.0",
+            &["media.fog.density", "not both"],
+        ),
+        ("g = 0.5", &["media.fog.color", "missing"]),
+    ] {
+        assert_error(&with_medium(fields), None, needles);
+    }
+}
+
+#[test]
+fn unknown_medium_names_are_named_where_they_are_used() {
+    let text =
+        with_medium("sigma_s = [1.0, 1.0, 1.0]").replace("medium = \"fog\"", "medium = \"smoke\"");
+    assert_error(
+        &text,
+        Some(27),
+        &["spheres[0].medium", "unknown medium \"smoke\"", "\"fog\""],
+    );
+    let text = edited("max_bounces = 4\n", "max_bounces = 4\nmedium = \"haze\"\n");
+    assert_error(
+        &text,
+        Some(12),
+        &["render.medium", "unknown medium \"haze\"", "none"],
+    );
+}
+
+#[test]
+fn a_quad_or_an_open_mesh_cannot_hold_a_medium() {
+    let text = edited(
+        "material = \"lamp\"\n",
+        "material = \"lamp\"\nmedium = \"fog\"\n",
+    ) + "\n[media.fog]\nsigma_s = [1.0, 1.0, 1.0]\n";
+    assert_error(&text, None, &["quads[0].medium", "bounds no volume"]);
+    let dir = tempfile::tempdir().unwrap();
+    // One triangle: three open edges.
+    std::fs::write(
+        dir.path().join("open.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let text = format!(
+        "{GOOD}\n[[meshes]]\nfile = \"open.obj\"\nmaterial = \"white\"\nmedium = \"fog\"\n\n[media.fog]\nsigma_s = [1.0, 1.0, 1.0]\n"
+    );
+    let path = dir.path().join("bad.toml");
+    let e = Scene::parse(&text, &path).expect_err("an open mesh cannot hold a medium");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("meshes[0].medium") && msg.contains("not closed (3 edges"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn an_interface_takes_no_ior_nor_colour() {
+    let text = edited(
+        "type = \"diffuse\"\ncolor = [0.7, 0.7, 0.7]",
+        "type = \"interface\"\nior = 1.5",
+    );
+    assert_error(
+        &text,
+        Some(15),
+        &["materials.white.ior", "no ior nor color"],
+    );
+}

@@ -12,6 +12,11 @@
 pub const PURPOSE_BSDF: u32 = 0;
 pub const PURPOSE_LIGHT: u32 = 1;
 pub const PURPOSE_ROULETTE: u32 = 2;
+/// Participating media (`src/cpu/media/`): a segment's free flight, a medium vertex's phase
+/// sampling and its next-event estimation.
+pub const PURPOSE_FREE_FLIGHT: u32 = 3;
+pub const PURPOSE_PHASE: u32 = 4;
+pub const PURPOSE_MEDIUM_LIGHT: u32 = 5;
 
 /// `Params::sampler`: independent uniform numbers (a PCG stream per sample).
 pub const SAMPLER_INDEPENDENT: u32 = 0;
@@ -19,7 +24,12 @@ pub const SAMPLER_INDEPENDENT: u32 = 0;
 pub const SAMPLER_SOBOL: u32 = 1;
 
 pub fn stream_id(bounce: u32, purpose: u32) -> u32 {
-    1 + 3 * bounce + purpose
+    if purpose < 3 {
+        return 1 + 3 * bounce + purpose;
+    }
+    // Later purposes get a range of their own (above any 1 + 3 · bounce), so that the first
+    // three keep their streams and media-free images their pixels.
+    0x8000_0000 + 8 * bounce + purpose
 }
 
 pub fn pcg_hash(v: u32) -> u32 {

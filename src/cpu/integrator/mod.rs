@@ -5,6 +5,7 @@ pub mod accumulate;
 pub mod aov;
 pub mod bdpt;
 pub mod path;
+pub mod path_media;
 pub mod pixel;
 pub mod renderer;
 pub mod splat;

@@ -8,12 +8,16 @@ use crate::cpu::geometry::hit::{Hit, NO_HIT};
 use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene};
 use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::integrator::aov::{aov_record_hit, aov_record_miss, aov_start, aovs_on, PathAov};
+use crate::cpu::integrator::path_media::{cross_interface, free_flight, medium_vertex};
 use crate::cpu::integrator::volume::volume_transmittance;
 use crate::cpu::lights::environment::environment_radiance;
 use crate::cpu::lights::light_sample::{nee_weight, power_heuristic, LightSample};
 use crate::cpu::lights::punctual::sun_disks_radiance;
 use crate::cpu::lights::sampling::{light_pdf, light_visible, sample_light};
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
+use crate::cpu::media::medium::{
+    is_interface, medium_crossed, medium_start, shadow_transmittance, MediumStack,
+};
 use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::normal_map::normal_mapped;
 use crate::cpu::textures::texture::material_at;
@@ -37,6 +41,8 @@ pub struct PathState {
     pub came_from_delta: bool,
     /// Albedo, normal and depth for the denoiser (aov.rs); untouched unless `params.aovs`.
     pub aov: PathAov,
+    /// The participating media the ray is in (media/medium.rs); empty without media.
+    pub media: MediumStack,
 }
 
 /// Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
@@ -63,6 +69,7 @@ pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) ->
         bounce: 0,
         came_from_delta: true,
         aov: aov_start(),
+        media: medium_start(params),
     }
 }
 
@@ -90,6 +97,25 @@ pub fn path_step(
     };
     let mut hit = intersect_scene(&scene.geometry, &ray);
     *segments += 1;
+    // The kernel compiles media in only for scenes that have them (HAS_MEDIA).
+    if params.medium_count > 0 {
+        let flight = free_flight(scene, path, hit.t, pixel, sample);
+        if flight.scattered {
+            let position = ray.origin + flight.t * ray.dir;
+            return medium_vertex(
+                scene,
+                path,
+                position,
+                light_sampling,
+                pixel,
+                sample,
+                segments,
+            );
+        }
+        if path.throughput == Vec3::ZERO {
+            return true;
+        }
+    }
     if hit.t == NO_HIT {
         add_escaped_light(scene, path, light_sampling);
         return true;
@@ -120,6 +146,9 @@ pub fn path_step(
     // max_bounces counts scattering events; this also bounds every path's length.
     if bounce >= params.max_bounces {
         return true;
+    }
+    if params.medium_count > 0 && is_interface(m) {
+        return cross_interface(scene, path, &hit);
     }
     let vertex = Vertex {
         material: m,
@@ -310,7 +339,20 @@ fn add_unblocked_light(
     } else {
         scene
     };
-    if light_visible(shadow_scene, &shadow, light) {
+    // Through participating media the light arrives attenuated, through interfaces too (the
+    // kernel's HAS_MEDIA); else it is seen or not.
+    let through = if params.medium_count > 0 {
+        let mut media = path.media;
+        if light.dir.dot(hit.normal) < 0.0 {
+            media = medium_crossed(params, &media, hit.material, hit.front_face);
+        }
+        shadow_transmittance(shadow_scene, &shadow, light, &media, segments)
+    } else if light_visible(shadow_scene, &shadow, light) {
+        Vec3::ONE
+    } else {
+        Vec3::ZERO
+    };
+    if through.cmpgt(Vec3::ZERO).any() {
         let pdf = bsdf_pdf(
             m,
             wo,
@@ -320,7 +362,8 @@ fn add_unblocked_light(
             hit.front_face,
         );
         let weight = nee_weight(light, pdf);
-        let contribution = path.throughput * f_cos * light.radiance * (weight / light.pdf);
+        let contribution =
+            path.throughput * f_cos * light.radiance * (weight / light.pdf) * through;
         path.radiance += firefly_clamp(params, contribution, bounce + 1);
     }
 }
@@ -388,6 +431,10 @@ fn scatter(
     };
     path.ray_start = p;
     path.bounce = bounce + 1;
+    // A direction through the surface enters or leaves the medium it bounds (HAS_MEDIA).
+    if params.medium_count > 0 && s.dir.dot(hit.normal) < 0.0 {
+        path.media = medium_crossed(params, &path.media, hit.material, hit.front_face);
+    }
     false
 }
 

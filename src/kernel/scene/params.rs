@@ -2,8 +2,8 @@
 //! size and rotation, and the camera.
 
 use crate::kernel::types::{
-    Emitter, Params, PRIMITIVE_ENVIRONMENT, PROJECTION_ORTHOGRAPHIC, PROJECTION_PERSPECTIVE,
-    ROULETTE_OFF,
+    Emitter, Medium, Params, NO_MEDIUM, PRIMITIVE_ENVIRONMENT, PROJECTION_ORTHOGRAPHIC,
+    PROJECTION_PERSPECTIVE, ROULETTE_OFF,
 };
 use crate::scene::environment::Environment;
 use crate::scene::{Camera, CameraBasis, Projection, Scene, ROULETTE_START_BOUNCE};
@@ -38,6 +38,42 @@ pub fn place_camera(params: &mut Params, camera: &Camera) {
 }
 
 impl Scene {
+    /// The media's slots (validation keeps them within `MAX_MEDIUM_SLOTS`): one per material
+    /// that bounds a medium, then the global medium and the camera's where no object bounds
+    /// it. The camera starts in the slot of an object filled with its medium where there is
+    /// one, so that leaving that object returns to the medium outside it.
+    fn place_media(&self, params: &mut Params) {
+        let media = &self.media;
+        params.global_medium = NO_MEDIUM;
+        params.camera_medium = NO_MEDIUM;
+        let mut count = 0;
+        let mut slot = |medium: u32, boundary: u32| {
+            let m = &media.list[medium as usize];
+            params.media[count] = Medium {
+                sigma_t: (m.sigma_a + m.sigma_s).into(),
+                g: m.g,
+                sigma_s: m.sigma_s.into(),
+                boundary,
+            };
+            count += 1;
+            count as u32 - 1
+        };
+        let mut camera = NO_MEDIUM;
+        for &(material, medium) in &media.boundaries {
+            let s = slot(medium, material);
+            if media.camera == Some(medium) && camera == NO_MEDIUM {
+                camera = s;
+            }
+        }
+        let global = media.global.map_or(NO_MEDIUM, |m| slot(m, NO_MEDIUM));
+        if let (Some(m), NO_MEDIUM) = (media.camera, camera) {
+            camera = slot(m, NO_MEDIUM);
+        }
+        params.medium_count = count as u32;
+        params.global_medium = global;
+        params.camera_medium = camera;
+    }
+
     /// The scene's `Params`, given its `emitters` (light sampling's table) and `environment`
     /// map; no samples yet, no AOVs nor clamp (the render's own settings set those).
     pub(super) fn kernel_params(
@@ -84,6 +120,7 @@ impl Scene {
             ..Default::default()
         };
         (params.scene_center, params.scene_radius) = self.bounding_sphere();
+        self.place_media(&mut params);
         place_camera(&mut params, &self.camera);
         params
     }

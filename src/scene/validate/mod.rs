@@ -7,11 +7,13 @@ mod environment;
 mod fields;
 mod lights;
 mod materials;
+mod media;
 mod objects;
 
 pub(super) use fields::FieldError;
 
 use super::file::{RenderToml, SceneToml};
+use super::medium::{Media, MAX_MEDIUM_SLOTS};
 use super::{
     check_image_size, check_integrator_bounces, Integrator, RenderSettings, Sampler, Scene,
     MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
@@ -41,6 +43,7 @@ impl SceneToml {
         })?;
         let camera_span = camera.span();
         let camera = camera.into_inner();
+        let camera_toml_medium = camera.medium.clone();
         let render = self.render.ok_or_else(|| {
             whole(
                 "[render]",
@@ -54,13 +57,42 @@ impl SceneToml {
 
         let settings = validate_render(&render, render_span)?;
         let mut materials = materials::validate_materials(&self.materials, folder)?;
+        let media = media::validate_media(&self.media)?;
+        let global = render
+            .medium
+            .as_ref()
+            .map(|m| media.reference(m, "render.medium"))
+            .transpose()?;
+        let camera_medium = camera_toml_medium
+            .as_ref()
+            .map(|m| media.reference(m, "camera.medium"))
+            .transpose()?
+            .filter(|&m| Some(m) != global);
         let objects = objects::validate_objects(
             &self.spheres,
             &self.quads,
             &self.meshes,
             folder,
             &mut materials,
+            &media,
         )?;
+        if objects.boundaries.len() + 2 > MAX_MEDIUM_SLOTS {
+            return Err(whole(
+                "media",
+                format!(
+                    "{} object materials bound media; the kernel holds at most {} (a material \
+                     per medium, for every object filled with it)",
+                    objects.boundaries.len(),
+                    MAX_MEDIUM_SLOTS - 2
+                ),
+            ));
+        }
+        if settings.integrator == Integrator::Bdpt && !media.list.is_empty() {
+            return Err(whole(
+                "render.integrator",
+                "the bdpt integrator does not render participating media yet; use \"path\"".into(),
+            ));
+        }
         let mut warnings = objects.warnings;
         let environment = match &self.environment {
             Some(e) => {
@@ -91,6 +123,12 @@ impl SceneToml {
                 let mut all = lights::validate_lights(&self.lights)?;
                 all.extend(objects.lights);
                 all
+            },
+            media: Media {
+                list: media.list,
+                global,
+                camera: camera_medium,
+                boundaries: objects.boundaries,
             },
         };
         Ok((scene, warnings))

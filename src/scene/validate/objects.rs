@@ -7,7 +7,9 @@ use super::super::mesh::{self, MeshTransform};
 use super::super::{AlphaMode, InstancedMesh, Material, Quad, Sphere, Triangle};
 use super::fields::{coordinates, fail, length_in_range, real, sine_between, vec3, FieldError};
 use super::materials::Materials;
+use super::media::MediaNames;
 use glam::{Mat4, Vec3};
+use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::Path;
 
@@ -21,6 +23,30 @@ pub(super) struct Objects {
     /// The punctual lights of glTF files (`[[meshes]] lights`, default true).
     pub(super) lights: Vec<Light>,
     pub(super) warnings: Vec<String>,
+    /// (material, medium): the materials made for objects that bound a medium.
+    pub(super) boundaries: Vec<(u32, u32)>,
+}
+
+/// Objects that bound a medium get a copy of their material for it (the kernel finds the
+/// medium inside an object from the material it hits): one per (material, medium) pair.
+struct Boundaries<'a> {
+    media: &'a MediaNames,
+    made: BTreeMap<(u32, u32), u32>,
+}
+
+impl Boundaries<'_> {
+    /// The material for objects of `material` filled with `medium`.
+    fn material(&mut self, material: u32, medium: u32, materials: &mut Materials) -> u32 {
+        *self.made.entry((material, medium)).or_insert_with(|| {
+            let mut copy = materials.list[material as usize].clone();
+            copy.name = format!(
+                "{} (medium {})",
+                copy.name, self.media.list[medium as usize].name
+            );
+            materials.list.push(copy);
+            materials.list.len() as u32 - 1
+        })
+    }
 }
 
 /// One warning per material that is alpha-tested or blended but used by spheres or quads,
@@ -52,12 +78,21 @@ pub(super) fn validate_objects(
     meshes_toml: &[S<MeshToml>],
     folder: &Path,
     materials: &mut Materials,
+    media: &MediaNames,
 ) -> Result<Objects, FieldError> {
-    let spheres = spheres_toml
-        .iter()
-        .enumerate()
-        .map(|(i, s)| validate_sphere(s.get_ref(), i, materials))
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut boundaries = Boundaries {
+        media,
+        made: BTreeMap::new(),
+    };
+    let mut spheres = Vec::with_capacity(spheres_toml.len());
+    for (i, s) in spheres_toml.iter().enumerate() {
+        let mut sphere = validate_sphere(s.get_ref(), i, materials)?;
+        if let Some(m) = &s.get_ref().medium {
+            let medium = media.reference(m, &format!("spheres[{i}].medium"))?;
+            sphere.material = boundaries.material(sphere.material, medium, materials);
+        }
+        spheres.push(sphere);
+    }
     let quads = quads_toml
         .iter()
         .enumerate()
@@ -72,7 +107,17 @@ pub(super) fn validate_objects(
         warnings: opaque_only_warnings(&spheres, &quads, &materials.list),
     };
     for (i, m) in meshes_toml.iter().enumerate() {
+        let medium = match &m.get_ref().medium {
+            Some(name) => Some((media.reference(name, &format!("meshes[{i}].medium"))?, name)),
+            None => None,
+        };
+        let (triangles, instanced) = (meshes.triangles.len(), meshes.instanced.len());
         meshes.add(m.get_ref(), i, folder, materials)?;
+        if let Some((medium, name)) = medium {
+            meshes
+                .fill(triangles, instanced, medium, materials, &mut boundaries)
+                .or_else(|message| fail(name.span(), format!("meshes[{i}].medium"), message))?;
+        }
     }
     Ok(Objects {
         spheres,
@@ -81,6 +126,11 @@ pub(super) fn validate_objects(
         instanced: meshes.instanced,
         lights: meshes.lights,
         warnings: meshes.warnings,
+        boundaries: boundaries
+            .made
+            .iter()
+            .map(|(&(_, medium), &material)| (material, medium))
+            .collect(),
     })
 }
 
@@ -134,6 +184,13 @@ fn validate_quad(q: &QuadToml, i: usize, materials: &Materials) -> Result<Quad, 
         }
     }
     let material = materials.reference(&q.material, field("material"))?;
+    if let Some(m) = &q.medium {
+        return fail(
+            m.span(),
+            field("medium"),
+            "a quad bounds no volume: a medium fills a sphere or a closed mesh",
+        );
+    }
     Ok(Quad {
         corner,
         u,
@@ -206,6 +263,42 @@ impl Meshes {
                     mesh::MAX_TRIANGLES
                 ),
             );
+        }
+        Ok(())
+    }
+
+    /// Fills the mesh just added (its triangles from `triangles` on, its instanced meshes
+    /// from `instanced` on) with `medium`: each of its materials replaced by the copy that
+    /// bounds it. The mesh must be closed, or inside and outside are not defined.
+    fn fill(
+        &mut self,
+        triangles: usize,
+        instanced: usize,
+        medium: u32,
+        materials: &mut Materials,
+        boundaries: &mut Boundaries,
+    ) -> Result<(), String> {
+        let open = |t: &[Triangle]| open_edges(t);
+        let own = open(&self.triangles[triangles..]);
+        let placed = self.instanced[instanced..]
+            .iter()
+            .map(|m| open(&m.triangles))
+            .max()
+            .unwrap_or(0);
+        if own + placed > 0 {
+            return Err(format!(
+                "the mesh is not closed ({} edges belong to an odd number of triangles): a \
+                 medium fills only a closed mesh, whose inside is defined",
+                own.max(placed)
+            ));
+        }
+        for t in &mut self.triangles[triangles..] {
+            t.material = boundaries.material(t.material, medium, materials);
+        }
+        for mesh in &mut self.instanced[instanced..] {
+            for t in &mut mesh.triangles {
+                t.material = boundaries.material(t.material, medium, materials);
+            }
         }
         Ok(())
     }
@@ -367,4 +460,21 @@ fn instances(list: &S<Vec<S<toml::Value>>>, field: &str) -> Result<Vec<MeshTrans
         out.push(instance);
     }
     Ok(out)
+}
+
+/// How many edges of `triangles` (vertices matched by exact position) belong to an odd number
+/// of them: zero for a closed mesh, whose every edge two faces (or four, ...) share.
+fn open_edges(triangles: &[Triangle]) -> usize {
+    let key = |v: Vec3| v.to_array().map(f32::to_bits);
+    let mut odd = std::collections::HashSet::new();
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (key(t.vertices[k]), key(t.vertices[(k + 1) % 3]));
+            let edge = if a <= b { (a, b) } else { (b, a) };
+            if !odd.remove(&edge) {
+                odd.insert(edge);
+            }
+        }
+    }
+    odd.len()
 }

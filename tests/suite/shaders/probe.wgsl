@@ -56,6 +56,20 @@ fn probe_cosine_hemisphere(@builtin(global_invocation_id) id: vec3<u32>) {
     probe_out[id.x] = vec4<f32>(sample_cosine_hemisphere(probe.normal, u), 0.0);
 }
 
+// Henyey-Greenstein sampling about probe.normal (the direction light travelled) with
+// g = probe.alpha: the direction, and the phase function's value for it.
+@compute @workgroup_size(256, 1, 1)
+fn probe_hg(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= probe.count {
+        return;
+    }
+    var rng = rng_stream(id.x, 0u, 1u, probe.seed, SAMPLER_INDEPENDENT);
+    let u1 = rng_next(&rng);
+    let u2 = rng_next(&rng);
+    let dir = sample_hg(probe.alpha, probe.normal, u1, u2);
+    probe_out[id.x] = vec4<f32>(dir, hg_phase(probe.alpha, dot(probe.normal, dir)));
+}
+
 // Light sampling from probe.position in the bound scene: direction and pdf.
 @compute @workgroup_size(256, 1, 1)
 fn probe_light(@builtin(global_invocation_id) id: vec3<u32>) {

@@ -23,11 +23,12 @@ pub(super) fn material_kind(
         "metal" => metal_kind(m, field),
         "dielectric" => dielectric_kind(m, field),
         "pbr" => pbr_kind(m, field, folder, textures),
+        "interface" => interface_kind(m, field),
         other => fail(
             m.kind.span(),
             field("type"),
             format!(
-                "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\", \"pbr\""
+                "unknown material type {other:?}; known types: \"diffuse\", \"specular\", \"metal\", \"dielectric\", \"pbr\", \"interface\""
             ),
         ),
     }
@@ -62,6 +63,30 @@ fn dielectric_kind(
 ) -> Result<MaterialKind, FieldError> {
     let ior = ior_in_range(required(m, &m.ior, "ior", "dielectric", field)?, field)?;
     Ok(MaterialKind::Dielectric { ior })
+}
+
+/// An interface: a boundary that only separates media, passing light straight through. It is
+/// an index-matched, untinted dielectric (which the kernel, where there are media, crosses
+/// without counting it as a scattering event: shaders/media/medium.wgsl), so it takes no
+/// `ior` nor `color`.
+fn interface_kind(
+    m: &MaterialToml,
+    field: &dyn Fn(&str) -> String,
+) -> Result<MaterialKind, FieldError> {
+    for (x, name) in [
+        (m.ior.as_ref().map(|x| x.span()), "ior"),
+        (m.color.as_ref().map(|x| x.span()), "color"),
+    ] {
+        if let Some(span) = x {
+            return fail(
+                span,
+                field(name),
+                "an interface passes light straight through: it takes no ior nor color (use a \
+                 dielectric for a refracting boundary)",
+            );
+        }
+    }
+    Ok(MaterialKind::Dielectric { ior: 1.0 })
 }
 
 /// A field this kind (`what`) of material needs; its absence fails at the material's `type`.

@@ -1,0 +1,158 @@
+// Homogeneous media along a path (mirror: src/cpu/media/medium.rs, which says how the stack
+// follows boundaries and how free flights are sampled: spectral MIS over the three channels).
+
+const MEDIUM_STACK_SIZE: u32 = 4u;
+const MAX_SHADOW_CROSSINGS: u32 = 8u;
+
+// The media a path is in: slots[0 .. depth], innermost last.
+struct MediumStack {
+    slots: array<u32, 4>,
+    depth: u32,
+}
+
+fn medium_start() -> MediumStack {
+    var stack = MediumStack(array<u32, 4>(0u, 0u, 0u, 0u), 0u);
+    if params.camera_medium < params.medium_count {
+        stack.slots[0] = params.camera_medium;
+        stack.depth = 1u;
+    }
+    return stack;
+}
+
+fn current_medium(stack_in: MediumStack) -> u32 {
+    var stack = stack_in;
+    if stack.depth > 0u {
+        return stack.slots[stack.depth - 1u];
+    }
+    if params.global_medium < params.medium_count {
+        return params.global_medium;
+    }
+    return NO_MEDIUM;
+}
+
+fn boundary_slot(material: u32) -> u32 {
+    for (var i = 0u; i < min(params.medium_count, 8u); i++) {
+        if params.media[i].boundary == material {
+            return i;
+        }
+    }
+    return NO_MEDIUM;
+}
+
+fn medium_crossed(stack_in: MediumStack, material: u32, front_face: bool) -> MediumStack {
+    var out = stack_in;
+    let slot = boundary_slot(material);
+    if slot == NO_MEDIUM {
+        return out;
+    }
+    if front_face {
+        if out.depth < MEDIUM_STACK_SIZE {
+            out.slots[out.depth] = slot;
+            out.depth += 1u;
+        }
+        return out;
+    }
+    // The innermost entry of this medium goes; those inside it move down.
+    var found = false;
+    for (var k = 0u; k < out.depth; k++) {
+        let i = out.depth - 1u - k;
+        if !found && out.slots[i] == slot {
+            found = true;
+            for (var j = i; j < MEDIUM_STACK_SIZE - 1u; j++) {
+                out.slots[j] = out.slots[j + 1u];
+            }
+        }
+    }
+    if found {
+        out.depth -= 1u;
+    }
+    return out;
+}
+
+// An index-matched, untinted dielectric (type = "interface").
+fn is_interface(m: Material) -> bool {
+    return m.kind == MATERIAL_DIELECTRIC && m.ior == 1.0 && all(m.albedo == vec3<f32>(1.0));
+}
+
+// exp(-sigma_t d) per channel; 1 where sigma_t is 0 (also over an infinite d).
+fn transmittance(sigma_t: vec3<f32>, d: f32) -> vec3<f32> {
+    return select(vec3<f32>(1.0), exp(-(sigma_t * d)), sigma_t > vec3<f32>(0.0));
+}
+
+struct FreeFlight {
+    t: f32,
+    weight: vec3<f32>,
+    // True when it ended in the medium, false at the surface.
+    scattered: bool,
+}
+
+fn sample_free_flight(m: Medium, t_max: f32, u_channel: f32, u_distance: f32) -> FreeFlight {
+    let sigma_t = m.sigma_t;
+    let channel = min(u32(u_channel * 3.0), 2u);
+    let s = sigma_t[channel];
+    var t = NO_HIT;
+    if s > 0.0 {
+        t = -log(1.0 - u_distance) / s;
+    }
+    if t < t_max {
+        let tr = transmittance(sigma_t, t);
+        let pdf = dot(sigma_t * tr, vec3<f32>(1.0 / 3.0));
+        return FreeFlight(t, m.sigma_s * tr / pdf, true);
+    }
+    let tr = transmittance(sigma_t, t_max);
+    let survival = dot(tr, vec3<f32>(1.0 / 3.0));
+    var weight = vec3<f32>(0.0);
+    if survival > 0.0 {
+        weight = tr / survival;
+    }
+    return FreeFlight(t_max, weight, false);
+}
+
+// The transmittance from the shadow ray's origin (in the media of stack) to the sampled light,
+// through interfaces; zero where anything else blocks it. Uses the alpha key the caller set.
+fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack) -> vec3<f32> {
+    var ray = shadow;
+    var media = stack;
+    var through = vec3<f32>(1.0);
+    for (var i = 0u; i < MAX_SHADOW_CROSSINGS; i++) {
+        if i > 0u {
+            segments += 1u;
+        }
+        let hit = intersect_scene(ray);
+        var t_light = -1.0;
+        if light.primitive == PRIMITIVE_ENVIRONMENT {
+            if hit.t == NO_HIT {
+                t_light = NO_HIT;
+            }
+        } else if light.primitive == PRIMITIVE_LIGHT {
+            let l = lights[light.index];
+            if l.kind == LIGHT_SUN {
+                if hit.t == NO_HIT {
+                    t_light = NO_HIT;
+                }
+            } else {
+                let t = dot(l.position - ray.origin, ray.dir);
+                if hit.t >= t {
+                    t_light = t;
+                }
+            }
+        } else if hit.t != NO_HIT && hit.primitive == light.primitive && hit.index == light.index {
+            t_light = hit.t;
+        }
+        let slot = current_medium(media);
+        var sigma_t = vec3<f32>(0.0);
+        if slot != NO_MEDIUM {
+            sigma_t = params.media[slot].sigma_t;
+        }
+        if t_light >= 0.0 {
+            return through * transmittance(sigma_t, t_light);
+        }
+        if hit.t == NO_HIT || !is_interface(materials[hit.material]) {
+            return vec3<f32>(0.0);
+        }
+        through *= transmittance(sigma_t, hit.t);
+        media = medium_crossed(media, hit.material, hit.front_face);
+        ray = Ray(offset_ray_origin(hit.position, hit.error, -hit.normal), ray.dir);
+    }
+    return vec3<f32>(0.0);
+}

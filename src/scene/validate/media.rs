@@ -1,0 +1,192 @@
+//! `[media.NAME]`: homogeneous media, their coefficients checked, and references to them by
+//! name (`medium = "NAME"` on `[render]`, `[camera]`, spheres and meshes).
+
+use super::super::file::{MediumToml, Real, Triple, S};
+use super::super::limits::{MAX_COORDINATE, MIN_LENGTH};
+use super::super::medium::{Medium, MAX_COEFFICIENT};
+use super::fields::{fail, real, vec3, FieldError};
+use glam::Vec3;
+use std::collections::BTreeMap;
+
+/// The scene's media, and their indices by name.
+pub(super) struct MediaNames {
+    pub(super) list: Vec<Medium>,
+    index_of: BTreeMap<String, u32>,
+}
+
+impl MediaNames {
+    /// The index of the medium `m` names; an unknown name fails at `field`.
+    pub(super) fn reference(&self, m: &S<String>, field: &str) -> Result<u32, FieldError> {
+        self.index_of.get(m.get_ref()).copied().ok_or_else(|| {
+            let known: Vec<_> = self.index_of.keys().map(|k| format!("{k:?}")).collect();
+            FieldError {
+                span: Some(m.span()),
+                field: field.into(),
+                message: format!(
+                    "unknown medium {:?}; defined media: {}",
+                    m.get_ref(),
+                    if known.is_empty() {
+                        "none (define one with [media.NAME])".into()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            }
+        })
+    }
+}
+
+/// The `[media]` tables, in name order.
+pub(super) fn validate_media(
+    toml: &BTreeMap<String, S<MediumToml>>,
+) -> Result<MediaNames, FieldError> {
+    let mut list = Vec::new();
+    let mut index_of = BTreeMap::new();
+    for (name, m) in toml {
+        index_of.insert(name.clone(), list.len() as u32);
+        list.push(validate_medium(name, m)?);
+    }
+    Ok(MediaNames { list, index_of })
+}
+
+/// `[media.NAME]`: exactly one of the two forms, every coefficient ≥ 0 and finite, |g| < 1.
+fn validate_medium(name: &str, m: &S<MediumToml>) -> Result<Medium, FieldError> {
+    let field = |f: &str| format!("media.{name}.{f}");
+    let span = m.span();
+    let m = m.get_ref();
+    let physical = m.sigma_a.is_some() || m.sigma_s.is_some();
+    let artist = m.color.is_some() || m.density.is_some() || m.mean_free_path.is_some();
+    let (sigma_a, sigma_s) = if physical {
+        if artist {
+            let which = if m.color.is_some() {
+                "color"
+            } else if m.density.is_some() {
+                "density"
+            } else {
+                "mean_free_path"
+            };
+            return fail(
+                span,
+                field(which),
+                "give either sigma_a and sigma_s, or color with density or mean_free_path, not both",
+            );
+        }
+        let a = m
+            .sigma_a
+            .as_ref()
+            .map_or(Ok(Vec3::ZERO), |s| coefficient(s, &field("sigma_a")))?;
+        let s = m
+            .sigma_s
+            .as_ref()
+            .map_or(Ok(Vec3::ZERO), |s| coefficient(s, &field("sigma_s")))?;
+        (a, s)
+    } else {
+        let Some(color) = &m.color else {
+            return fail(
+                span,
+                field("color"),
+                "missing: a medium needs sigma_a and sigma_s, or color with density or mean_free_path",
+            );
+        };
+        let albedo = vec3(color, &field("color"))?;
+        if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
+            return fail(
+                color.span(),
+                field("color"),
+                format!("the single-scattering albedo must be in [0, 1] per channel, got {albedo}"),
+            );
+        }
+        let sigma_t = match (&m.density, &m.mean_free_path) {
+            (Some(d), None) => {
+                let d = real(d, &field("density")).and_then(|v| {
+                    if !(0.0..=MAX_COEFFICIENT).contains(&v) {
+                        fail(
+                            d.span(),
+                            field("density"),
+                            format!("must be in [0, {MAX_COEFFICIENT:e}] per unit length, got {v}"),
+                        )
+                    } else {
+                        Ok(v)
+                    }
+                })?;
+                Vec3::splat(d)
+            }
+            (None, Some(p)) => mean_free_path(p, &field("mean_free_path"))?.recip(),
+            (Some(_), Some(p)) => {
+                return fail(
+                    p.span(),
+                    field("mean_free_path"),
+                    "give density or mean_free_path, not both",
+                )
+            }
+            (None, None) => {
+                return fail(
+                    color.span(),
+                    field("density"),
+                    "missing: a medium given by color needs density or mean_free_path",
+                )
+            }
+        };
+        (sigma_t * (Vec3::ONE - albedo), sigma_t * albedo)
+    };
+    let g = match &m.g {
+        Some(g) => {
+            let v = real(g, &field("g"))?;
+            // At ±1 the phase function is a delta, which neither sampling nor its pdf handles.
+            if v.abs() >= 1.0 {
+                return fail(
+                    g.span(),
+                    field("g"),
+                    format!("must be in (-1, 1) (0 scatters evenly, > 0 forwards), got {v}"),
+                );
+            }
+            v
+        }
+        None => 0.0,
+    };
+    Ok(Medium {
+        name: name.into(),
+        sigma_a,
+        sigma_s,
+        g,
+    })
+}
+
+/// An absorption or scattering coefficient per channel: finite, in [0, MAX_COEFFICIENT].
+fn coefficient(x: &S<Triple>, field: &str) -> Result<Vec3, FieldError> {
+    let v = vec3(x, field)?;
+    if v.min_element() < 0.0 {
+        return fail(
+            x.span(),
+            field,
+            format!("coefficients must be ≥ 0 (per unit length), got {v}"),
+        );
+    }
+    if v.max_element() > MAX_COEFFICIENT {
+        return fail(
+            x.span(),
+            field,
+            format!("coefficients must be at most {MAX_COEFFICIENT:e} per unit length, got {v}"),
+        );
+    }
+    Ok(v)
+}
+
+/// A mean free path: one length or three, each in [MIN_LENGTH, MAX_COORDINATE].
+fn mean_free_path(x: &S<toml::Value>, field: &str) -> Result<Vec3, FieldError> {
+    let v = match x.get_ref() {
+        toml::Value::Float(f) => Vec3::splat(real(&S::new(x.span(), Real(*f)), field)?),
+        toml::Value::Integer(i) => Vec3::splat(*i as f32),
+        _ => vec3(x, field)?,
+    };
+    if v.min_element() < MIN_LENGTH || v.max_element() > MAX_COORDINATE {
+        return fail(
+            x.span(),
+            field,
+            format!(
+                "must be in [{MIN_LENGTH:e}, {MAX_COORDINATE:e}] (a length glint supports), got {v}"
+            ),
+        );
+    }
+    Ok(v)
+}
