@@ -9,6 +9,7 @@
 //! of samples. Since batches are split only at block ends (`kernel::schedule`), the floats
 //! depend on the sample indices alone: any batching gives the same bytes.
 
+use crate::cpu::integrator::path::PixelStats;
 use crate::kernel::schedule::is_block_end;
 use glam::Vec3;
 
@@ -27,6 +28,12 @@ pub struct Accumulator {
     pub block_m2: Vec3,
     /// Samples dropped since the accumulator started.
     pub nonfinite: u32,
+}
+
+/// Whether adaptive sampling has stopped the pixel (the kernel reads a flag the host sets in
+/// the pixel's M2; here it is [`PixelStats::stopped`]).
+pub fn pixel_stopped(stats: &PixelStats) -> bool {
+    stats.stopped
 }
 
 pub fn accumulator_start(count: u32, mean: Vec3, m2: Vec3) -> Accumulator {

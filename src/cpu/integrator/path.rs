@@ -417,6 +417,9 @@ pub struct PixelStats {
     pub nonfinite: u32,
     /// Mean albedo, normal and depth, when `params.aovs` asks for them.
     pub aov: AovMean,
+    /// Adaptive sampling has stopped the pixel: it takes no more samples (the kernel's flag in
+    /// the w of the pixel's M2).
+    pub stopped: bool,
 }
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
@@ -426,6 +429,10 @@ pub struct PixelStats {
 pub fn render_pixel(scene: &SceneRefs, px: u32, py: u32, stats: &mut PixelStats) -> u32 {
     let params = scene.params;
     let pixel = py * params.width + px;
+    // Adaptive sampling: a pixel the host has stopped takes no more samples (accumulate.rs).
+    if crate::cpu::integrator::accumulate::pixel_stopped(stats) {
+        return 0;
+    }
     let mut acc = accumulator_start(params.accumulated_samples, stats.mean, stats.m2);
     let mut aov_mean = AovMean::default();
     let mut segments = 0;
