@@ -12,7 +12,8 @@
 //! taken relative to 0.1, so black and near-black pixels are not chased for a relative error
 //! no one sees.
 //!
-//! A pixel stops once e ≤ the target for each of the 8 pixels around it, its own left out.
+//! A pixel stops once e ≤ the target for each of the 8 pixels around it that still take
+//! samples, its own left out.
 //! Deciding from a pixel's own samples biases its mean: with skewed samples (rare bright
 //! paths), a low variance estimate goes with a low mean, so pixels that stop early stop low.
 //! On the 64² Cornell box at a target of 0.05 that made the image 0.9% dark (z of the image
@@ -21,7 +22,8 @@
 //! neighbour's own stop depends on this pixel's samples, which moves what the neighbour holds
 //! at later checkpoints; tests/suite/adaptive.rs measures what is left.) The neighbours are
 //! also a larger sample of the error where the image is smooth; an isolated noisy pixel
-//! among converged ones can stop noisy.
+//! among converged ones can stop noisy. Neighbours already stopped are left out (their error
+//! no longer falls), so a pixel whose neighbours have all stopped stops too.
 
 use crate::image::compare::REL_MSE_EPSILON;
 use crate::kernel::schedule::is_block_end;
@@ -113,28 +115,29 @@ pub fn pixel_errors_squared(acc: &Accumulation) -> Vec<f64> {
         .collect()
 }
 
-/// The pixels whose neighbours' estimated errors (the 8 around it, within the image; the
-/// pixel itself left out) are all at most `target`: those that may stop. A 1×1 image has no
-/// neighbours and decides by its own pixel.
+/// The pixels whose neighbours that still take samples (the 8 around it, within the image, the
+/// pixel itself left out; those holding all `acc.count` samples) all have estimated errors at
+/// most `target`: those that may stop. A stopped neighbour no longer counts: its error is
+/// frozen, and would otherwise keep its neighbours sampling forever. A pixel with no such
+/// neighbour stops too, except in a 1×1 image, which decides by its own pixel.
 pub fn converged(acc: &Accumulation, target: f64) -> Vec<bool> {
     let errors = pixel_errors_squared(acc);
     let limit = target * target;
     let (w, h) = (acc.width as usize, acc.height as usize);
+    if w * h == 1 {
+        return vec![errors[0] <= limit];
+    }
     (0..w * h)
         .map(|i| {
             let (x, y) = (i % w, i / w);
-            let mut neighbours = 0;
             let mut worst = 0.0f64;
             for yy in y.saturating_sub(1)..(y + 2).min(h) {
                 for xx in x.saturating_sub(1)..(x + 2).min(w) {
-                    if (xx, yy) != (x, y) {
-                        neighbours += 1;
-                        worst = worst.max(errors[yy * w + xx]);
+                    let q = yy * w + xx;
+                    if q != i && acc.counts[q] == acc.count {
+                        worst = worst.max(errors[q]);
                     }
                 }
-            }
-            if neighbours == 0 {
-                worst = errors[i];
             }
             worst <= limit
         })
@@ -197,6 +200,9 @@ mod tests {
             }
         }
         assert!(converged(&a, 0.31).iter().all(|&s| s));
+        // Once the noisy pixel has stopped (fewer samples than the rest), it holds no one back.
+        a.counts[6] = 8;
+        assert!(converged(&a, 0.1).iter().all(|&s| s));
     }
 
     #[test]
