@@ -380,3 +380,64 @@ fn adaptive_shards_merge_pixel_by_pixel() {
     assert!(worst <= 1.0, "{worst}");
     assert_eq!((m.counts[0], m.mean[0]), (80, [0.5; 3]));
 }
+
+/// A partial file with per-pixel counts reads back as written (version 2, channel N); one
+/// whose counts exceed its samples, or whose N channel is missing, is refused with the file
+/// named; a plain accumulation is written as version 1, which glint before adaptive sampling
+/// reads.
+#[test]
+fn partial_files_keep_each_pixels_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut a = Accumulation::empty(3, 2);
+    a.count = 64;
+    a.counts = vec![16, 64, 32, 64, 64, 16];
+    for (i, p) in a.mean.iter_mut().enumerate() {
+        *p = [i as f32, 0.5, 0.25];
+    }
+    let info = glint::render::partial::PartialInfo {
+        ranges: std::iter::once(0..64).collect(),
+        target: 0..64,
+        spp: 64,
+        seed: 3,
+        settings: "x".into(),
+        scene: "s.toml".into(),
+        device: "cpu".into(),
+        adaptive: Some(adaptive(0.05)),
+    };
+    let partial = Partial {
+        info: info.clone(),
+        accumulation: a.clone(),
+    };
+    let path = dir.path().join("p.exr");
+    partial.write(&path).unwrap();
+    assert_eq!(Partial::read(&path).unwrap(), partial);
+    let bytes = std::fs::read(&path).unwrap();
+    let has = |b: &[u8], s: &str| b.windows(s.len()).any(|w| w == s.as_bytes());
+    assert!(has(&bytes, FORMAT_COUNTS));
+    // Counts beyond the file's samples (its header's ranges, 0..64): refused.
+    let mut bad = partial.clone();
+    bad.accumulation.counts[2] = 65;
+    bad.write(&path).unwrap();
+    let e = Partial::read(&path).unwrap_err();
+    assert!(
+        e.contains("p.exr") && e.contains("more than the file's 64"),
+        "{e}"
+    );
+    // Version 2 without its channel N (the counts made uniform, the format kept): refused.
+    let mut uniform = partial.clone();
+    uniform.accumulation.counts = vec![64; 6];
+    uniform.write(&path).unwrap();
+    let mut text = std::fs::read(&path).unwrap();
+    let at = text
+        .windows(FORMAT.len())
+        .position(|w| w == FORMAT.as_bytes())
+        .unwrap();
+    text[at..at + FORMAT.len()].copy_from_slice(FORMAT_COUNTS.as_bytes());
+    std::fs::write(&path, &text).unwrap();
+    let e = Partial::read(&path).unwrap_err();
+    assert!(e.contains("channel N is missing"), "{e}");
+    // A plain accumulation stays version 1.
+    uniform.write(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    assert!(has(&bytes, FORMAT) && !has(&bytes, FORMAT_COUNTS));
+}
