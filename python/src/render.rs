@@ -135,6 +135,7 @@ fn run(
     let rules = StopRules {
         time_limit: options.time_limit,
         target_error: None,
+        adaptive: None,
         interrupted: Some(stop),
     };
     let mut sizer = BatchSizer::new(BATCH_TARGET);

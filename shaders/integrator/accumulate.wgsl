@@ -32,6 +32,12 @@ struct Accumulator {
     nonfinite: u32,
 }
 
+// Whether adaptive sampling has stopped the pixel: the host marks it by a non-zero w in its M2
+// (src/gpu/renderer.rs), which the kernel's own writes leave 0 (render() in path.wgsl).
+fn pixel_stopped(pixel: u32) -> bool {
+    return accum_m2[pixel].w != 0.0;
+}
+
 fn accumulator_start(count: u32, mean: vec3<f32>, m2: vec3<f32>) -> Accumulator {
     return Accumulator(count, mean, m2, 0u, vec3<f32>(0.0), vec3<f32>(0.0), 0u);
 }

@@ -286,6 +286,10 @@ fn render(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pixel = py * params.width + px;
+    // Adaptive sampling: a pixel the host has stopped takes no more samples (accumulate.wgsl).
+    if pixel_stopped(pixel) {
+        return;
+    }
     var acc = accumulator_start(params.accumulated_samples, accum_mean[pixel].xyz, accum_m2[pixel].xyz);
     var aov_mean = aov_mean_start();
     // Path regeneration: one loop over segments, and a lane whose path ends starts its next

@@ -80,6 +80,8 @@ pub fn run(args: MergeArgs) -> Result<()> {
             "width": a.width,
             "height": a.height,
             "spp": a.count,
+            // Adaptive parts: the mean of the pixels' own counts (else the same as spp).
+            "mean_spp": a.total_samples() as f64 / a.counts.len().max(1) as f64,
             "render_spp": info.spp,
             "seed": info.seed,
             "samples": format_ranges(&info.ranges),

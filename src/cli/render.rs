@@ -11,6 +11,7 @@ use crate::image::format::ImageFormat;
 use crate::image::output_check::OutputSet;
 use crate::kernel::types::Params;
 use crate::kernel::KernelScene;
+use crate::render::adaptive::{Adaptive, DEFAULT_MIN_SPP};
 use crate::render::interrupt::{self, Interrupted};
 use crate::render::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
@@ -86,8 +87,20 @@ pub struct RenderArgs {
     /// √(mean of the variance image) / (mean of the image), is at most E (checked from 8 spp on).
     /// --spp is then the upper bound, and --time-limit still holds. On a black image (mean 0)
     /// the relative error is undefined, so it never stops the render (a note says so).
+    /// With --adaptive, E is instead each pixel's target (see there).
     #[arg(long, value_name = "E", value_parser = parse_target_error, allow_negative_numbers = true)]
     pub target_error: Option<f64>,
+    /// Adaptive sampling: after --adaptive-min-spp samples, a pixel stops taking samples once
+    /// its estimated relative error, √(mean over channels of σ²/(μ² + 0.01)) with σ² the
+    /// variance of its mean, and its 3×3 neighbours' are at most --target-error. --spp is then
+    /// each pixel's cap; the render ends when every pixel has stopped or reached it (or at
+    /// --time-limit), and the time goes to the pixels that are still noisy.
+    #[arg(long, requires = "target_error")]
+    pub adaptive: bool,
+    /// Samples every pixel takes before adaptive sampling may stop it.
+    #[arg(long, value_name = "N", requires = "adaptive", default_value_t = DEFAULT_MIN_SPP,
+          value_parser = clap::value_parser!(u32).range(2..=MAX_SPP as i64), allow_negative_numbers = true)]
+    pub adaptive_min_spp: u32,
     /// Print a JSON summary on stdout at the end. Its "seconds" is the time spent rendering
     /// batches only: start-up, scene upload, shader compilation and file writes are not in it
     /// ("wall_seconds" is the whole command).
@@ -232,8 +245,9 @@ struct FinishedRun<'a> {
     kernel_scene: &'a KernelScene,
     output: &'a std::path::Path,
     stats: &'a crate::render::RenderStats,
-    /// Samples per pixel of a resumed file, not rendered by this run.
-    resumed: u32,
+    /// Paths of a resumed file (its samples, all pixels together), not rendered by this run.
+    resumed_paths: u64,
+    adaptive: Option<Adaptive>,
     relative_error: Option<f64>,
     denoise_seconds: Option<f64>,
     traversal: Option<crate::gpu::Traversal>,
@@ -248,8 +262,19 @@ fn json_summary(
 ) -> serde_json::Value {
     let seconds = run.stats.render_time.as_secs_f64();
     // This run's paths only, not a resumed file's.
-    let paths = (run.scene.render.width as u64 * run.scene.render.height as u64)
-        * (run.stats.spp - run.resumed) as u64;
+    let counts = renderer.pixel_counts();
+    let all_paths: u64 = counts.iter().map(|&n| n as u64).sum();
+    let paths = all_paths - run.resumed_paths;
+    // Adaptive sampling: its settings, the pixels still taking samples at the end and the
+    // mean samples per pixel ("spp" is then the most any pixel took).
+    let adaptive = run.adaptive.map(|a| {
+        serde_json::json!({
+            "target_error": a.target_error,
+            "min_spp": a.min_spp,
+            "active_pixels": renderer.active_pixels(),
+            "mean_spp": all_paths as f64 / counts.len().max(1) as f64,
+        })
+    });
     serde_json::json!({
         "scene": args.scene.display().to_string(),
         "output": run.output.display().to_string(),
@@ -261,6 +286,7 @@ fn json_summary(
         "sampler": run.scene.render.sampler.name(),
         "integrator": run.scene.render.integrator.name(),
         "paths": paths,
+        "adaptive": adaptive,
         "seconds": seconds,
         "paths_per_second": paths as f64 / seconds.max(1e-9),
         "wall_seconds": started.elapsed().as_secs_f64(),
@@ -338,6 +364,24 @@ pub fn run(args: RenderArgs) -> Result<()> {
         )
         .into());
     }
+    // Adaptive sampling's settings: the command's, or a resumed adaptive file's.
+    let adaptive = match (args.target_error, &plan.resumed) {
+        (Some(target_error), _) if args.adaptive => Some(Adaptive {
+            target_error,
+            min_spp: args.adaptive_min_spp,
+        }),
+        (_, Some(resumed)) if resumed.info.adaptive.is_some() && args.target_error.is_none() => {
+            let a = resumed.info.adaptive;
+            crate::errln!(
+                "glint: note: {} was rendered with adaptive sampling; going on with its {}",
+                args.range.resume.as_ref().expect("resumed").display(),
+                a.expect("adaptive").to_header()
+            );
+            a
+        }
+        _ => None,
+    };
+
     let gpu = open_gpu(&args, scene.render.integrator)?;
     let (mut renderer, traversal) = make_renderer(&args, gpu.as_ref(), &kernel_scene)?;
 
@@ -360,6 +404,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             settings: settings_hash,
             scene: args.scene.display().to_string(),
             device: renderer.device_name(),
+            adaptive,
         },
     );
     let progress = progress_bar(plan.samples_wanted() as u64);
@@ -369,6 +414,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     let rules = StopRules {
         time_limit: args.time_limit.map(Duration::from_secs_f64),
         target_error: args.target_error,
+        adaptive,
         interrupted: Some(interrupt::install()?),
     };
     let stats = render_progressive(
@@ -380,6 +426,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
             progress.set_position(report.spp_done as u64);
             let rate = report.last_batch_spp as f64 * pixels / report.last_batch_time.as_secs_f64();
             let mut message = format!("{:.2} M samples/s", rate / 1e6);
+            if adaptive.is_some() {
+                message += &format!(
+                    "  active {:.1}%",
+                    100.0 * report.active_pixels as f64 / pixels
+                );
+            }
             if let Some(e) = report.relative_error {
                 message += &format!("  rel. error {:.2}%", 100.0 * e);
             }
@@ -416,7 +468,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
             kernel_scene: &kernel_scene,
             output: &output,
             stats: &stats,
-            resumed: plan.resumed.as_ref().map_or(0, |p| p.accumulation.count),
+            resumed_paths: plan
+                .resumed
+                .as_ref()
+                .map_or(0, |p| p.accumulation.total_samples()),
+            adaptive,
             relative_error: (stats.spp >= 2)
                 .then(|| relative_error(&mean, &variance))
                 .flatten(),

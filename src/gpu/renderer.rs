@@ -23,7 +23,7 @@ use crate::kernel::types::Params;
 use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
-use crate::render::accumulation::Accumulation;
+use crate::render::accumulation::{Accumulation, PixelCounts};
 use crate::render::{check_size, Renderer};
 use anyhow::{anyhow, Result};
 use wgpu::util::DeviceExt;
@@ -38,6 +38,9 @@ pub struct GpuRenderer<'a> {
     params: Params,
     params_buffer: wgpu::Buffer,
     samples: u32,
+    /// Which pixels adaptive sampling has stopped, and at how many samples (the kernel sees a
+    /// stopped pixel by the non-zero w of its M2: shaders/integrator/accumulate.wgsl).
+    counts: PixelCounts,
     first_sample: u32,
     /// Benchmark instrumentation, off unless asked for: it reads back after every batch.
     instruments: Option<Instruments>,
@@ -52,6 +55,9 @@ pub struct GpuRenderer<'a> {
     /// Where the kernel reads texels from (src/kernel/texels.rs).
     texel_binding: TexelBinding,
 }
+
+/// The w of a stopped pixel's M2 (shaders/integrator/accumulate.wgsl's `pixel_stopped`).
+const STOPPED_FLAG: f32 = 1.0;
 
 /// Wanted duration of one GPU submission: a batch longer than this is split into tiles.
 /// Desktop drivers kill submissions after about 2 s; lavapipe has no watchdog.
@@ -221,6 +227,7 @@ impl<'a> GpuRenderer<'a> {
             params,
             params_buffer,
             samples: 0,
+            counts: PixelCounts::new(pixel_count as usize),
             first_sample: 0,
             instruments: None,
             tiles: TilePlanner::new(SUBMISSION_TARGET),
@@ -512,6 +519,7 @@ impl Renderer for GpuRenderer<'_> {
             width: self.params.width,
             height: self.params.height,
             count: self.samples,
+            counts: self.counts.counts(self.samples),
             mean: self.read_vec3s(&self.images.mean)?,
             m2: self.read_vec3s(&self.images.m2)?,
             splats: Vec::new(),
@@ -523,16 +531,25 @@ impl Renderer for GpuRenderer<'_> {
         self.reset()?;
         if let Some(state) = state {
             check_size(&self.params, state)?;
-            let vec4s = |v: &[[f32; 3]]| -> Vec<[f32; 4]> {
-                v.iter().map(|p| [p[0], p[1], p[2], 0.0]).collect()
+            self.counts.load(&state.counts, state.count);
+            let vec4s = |v: &[[f32; 3]], w: &dyn Fn(usize) -> f32| -> Vec<[f32; 4]> {
+                v.iter()
+                    .enumerate()
+                    .map(|(i, p)| [p[0], p[1], p[2], w(i)])
+                    .collect()
             };
             let queue = &self.ctx.queue;
             queue.write_buffer(
                 &self.images.mean,
                 0,
-                bytemuck::cast_slice(&vec4s(&state.mean)),
+                bytemuck::cast_slice(&vec4s(&state.mean, &|_| 0.0)),
             );
-            queue.write_buffer(&self.images.m2, 0, bytemuck::cast_slice(&vec4s(&state.m2)));
+            let stopped = |i: usize| STOPPED_FLAG * self.counts.is_stopped(i) as u32 as f32;
+            queue.write_buffer(
+                &self.images.m2,
+                0,
+                bytemuck::cast_slice(&vec4s(&state.m2, &stopped)),
+            );
             self.samples = state.count;
         }
         self.first_sample = first_sample;
@@ -548,9 +565,14 @@ impl Renderer for GpuRenderer<'_> {
     }
 
     fn read_variance(&mut self) -> Result<Image> {
-        let n = self.samples;
+        let counts = self.counts.counts(self.samples);
         let m2 = self.read_vec3s(&self.images.m2)?;
-        Ok(self.image(m2.into_iter().map(|v| variance_of_mean(v, n)).collect()))
+        Ok(self.image(
+            m2.into_iter()
+                .zip(counts)
+                .map(|(v, n)| variance_of_mean(v, n))
+                .collect(),
+        ))
     }
 
     fn read_aovs(&mut self) -> Result<Aovs> {
@@ -576,6 +598,7 @@ impl Renderer for GpuRenderer<'_> {
         encoder.clear_buffer(&self.images.nonfinite, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.samples = 0;
+        self.counts.reset();
         self.nonfinite = 0;
         if let Some(instruments) = &mut self.instruments {
             instruments.segments = 0;
@@ -585,6 +608,31 @@ impl Renderer for GpuRenderer<'_> {
 
     fn segments_traced(&self) -> Option<u64> {
         self.instruments.as_ref().map(|i| i.segments)
+    }
+
+    fn stop_pixels(&mut self, stop: &[bool]) -> Result<()> {
+        let newly = self.counts.stop(stop, self.samples);
+        if newly.is_empty() {
+            return Ok(());
+        }
+        // The flag is the w of the pixel's M2, which the kernel leaves alone once it is set:
+        // rewrite the buffer with its own values and the flags (one readback, one upload).
+        let mut m2 = self.read_vec4s(&self.images.m2)?;
+        for i in newly {
+            m2[i][3] = STOPPED_FLAG;
+        }
+        self.ctx
+            .queue
+            .write_buffer(&self.images.m2, 0, bytemuck::cast_slice(&m2));
+        self.ctx.wait_idle()
+    }
+
+    fn pixel_counts(&self) -> Vec<u32> {
+        self.counts.counts(self.samples)
+    }
+
+    fn active_pixels(&self) -> usize {
+        self.counts.active()
     }
 
     fn last_kernel_time(&self) -> Option<std::time::Duration> {

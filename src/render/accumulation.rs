@@ -1,16 +1,21 @@
-//! A render's per-pixel running statistics (mean and M2 over a count of samples), as the
-//! renderers keep them and as partial files store them, and the exact pairwise merge of two.
+//! A render's per-pixel running statistics (mean and M2 over each pixel's count of samples), as
+//! the renderers keep them and as partial files store them, the exact pairwise merge of two,
+//! and which pixels still take samples (adaptive sampling, `src/render/adaptive.rs`).
 
 use crate::cpu::integrator::splat::fixed_point_value;
 use crate::image::output::Image;
 
-/// Per-pixel mean radiance and M2 (the sum of squared deviations from the mean) over `count`
-/// samples per pixel, row 0 at the top.
+/// Per-pixel mean radiance and M2 (the sum of squared deviations from the mean) over each
+/// pixel's own count of samples, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Accumulation {
     pub width: u32,
     pub height: u32,
+    /// Samples per pixel of the sample range(s) covered: the most any pixel holds.
     pub count: u32,
+    /// Each pixel's own sample count, at most `count`: all equal to it unless adaptive sampling
+    /// stopped some pixels early. A pixel stopped in a range holds that range's first samples.
+    pub counts: Vec<u32>,
     pub mean: Vec<[f32; 3]>,
     pub m2: Vec<[f32; 3]>,
     /// Bidirectional path tracing's splat film: per pixel and channel a 64-bit fixed-point
@@ -28,6 +33,7 @@ impl Accumulation {
             width,
             height,
             count: 0,
+            counts: vec![0; pixels],
             mean: vec![[0.0; 3]; pixels],
             m2: vec![[0.0; 3]; pixels],
             splats: Vec::new(),
@@ -35,31 +41,44 @@ impl Accumulation {
         }
     }
 
-    /// Adds `other`'s samples with Chan, Golub and LeVeque's pairwise update, in the kernel's
-    /// f32 arithmetic and operation order (`shaders/integrator/path.wgsl`, where a batch joins the
-    /// totals). So merging the statistics of consecutive sample ranges gives the same bits as
-    /// a render whose batches were those ranges. Both must have the same size.
+    /// Whether every pixel holds `count` samples (no pixel was stopped early).
+    pub fn is_uniform(&self) -> bool {
+        self.counts.iter().all(|&n| n == self.count)
+    }
+
+    /// Samples held by all pixels together.
+    pub fn total_samples(&self) -> u64 {
+        self.counts.iter().map(|&n| n as u64).sum()
+    }
+
+    /// Adds `other`'s samples with Chan, Golub and LeVeque's pairwise update, pixel by pixel
+    /// with each pixel's own counts, in the kernel's f32 arithmetic and operation order
+    /// (`shaders/integrator/accumulate.wgsl`, where a block joins the totals). So merging the
+    /// statistics of consecutive sample ranges gives the same bits as a render whose batches
+    /// were those ranges, and adaptive parts weigh each pixel by its own samples. Both must
+    /// have the same size.
     pub fn merge(&mut self, other: &Accumulation) {
         assert_eq!(
             (self.width, self.height),
             (other.width, other.height),
             "merging accumulations of different sizes"
         );
-        if other.count == 0 {
-            return;
-        }
-        let n_old = self.count as f32;
-        let n_new = other.count as f32;
-        let n = n_old + n_new;
-        let mean_weight = n_new / n;
-        let m2_weight = n_old * n_new / n;
         for i in 0..self.mean.len() {
+            if other.counts[i] == 0 {
+                continue;
+            }
+            let n_old = self.counts[i] as f32;
+            let n_new = other.counts[i] as f32;
+            let n = n_old + n_new;
+            let mean_weight = n_new / n;
+            let m2_weight = n_old * n_new / n;
             for c in 0..3 {
                 let old_mean = self.mean[i][c];
                 let delta = other.mean[i][c] - old_mean;
                 self.mean[i][c] = old_mean + delta * mean_weight;
                 self.m2[i][c] = self.m2[i][c] + other.m2[i][c] + delta * delta * m2_weight;
             }
+            self.counts[i] += other.counts[i];
         }
         self.count += other.count;
         // Splat sums are integers: they add exactly, in any order (wrapping as the kernel's do).
@@ -91,7 +110,8 @@ impl Accumulation {
         }
     }
 
-    /// The variance of each pixel's mean estimate (σ²/n), as `--variance` writes it.
+    /// The variance of each pixel's mean estimate (σ²/n, n the pixel's own count), as
+    /// `--variance` writes it.
     pub fn variance_image(&self) -> Image {
         Image {
             width: self.width,
@@ -99,7 +119,8 @@ impl Accumulation {
             pixels: self
                 .m2
                 .iter()
-                .map(|&m2| variance_of_mean(m2, self.count))
+                .zip(&self.counts)
+                .map(|(&m2, &n)| variance_of_mean(m2, n))
                 .collect(),
         }
     }
@@ -112,4 +133,61 @@ pub fn variance_of_mean(m2: [f32; 3], n: u32) -> [f32; 3] {
     }
     let scale = 1.0 / ((n as f64 - 1.0) * n as f64);
     m2.map(|v| (v.max(0.0) as f64 * scale) as f32)
+}
+
+/// Which pixels still take samples and how many each holds: the renderers' side of adaptive
+/// sampling. A pixel stopped at n samples keeps them and takes no more until a reset; the
+/// others hold all the renderer's samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PixelCounts {
+    /// The count each pixel stopped at; `u32::MAX` while it takes samples.
+    stopped_at: Vec<u32>,
+}
+
+impl PixelCounts {
+    /// Every pixel taking samples.
+    pub fn new(pixels: usize) -> PixelCounts {
+        PixelCounts {
+            stopped_at: vec![u32::MAX; pixels],
+        }
+    }
+
+    /// Every pixel taking samples again.
+    pub fn reset(&mut self) {
+        self.stopped_at.fill(u32::MAX);
+    }
+
+    pub fn is_stopped(&self, pixel: usize) -> bool {
+        self.stopped_at[pixel] != u32::MAX
+    }
+
+    /// Pixels still taking samples.
+    pub fn active(&self) -> usize {
+        self.stopped_at.iter().filter(|&&n| n == u32::MAX).count()
+    }
+
+    /// Each pixel's count when the renderer holds `samples` per pixel.
+    pub fn counts(&self, samples: u32) -> Vec<u32> {
+        self.stopped_at.iter().map(|&n| n.min(samples)).collect()
+    }
+
+    /// Takes the counts of a loaded accumulation: the pixels below `count` were stopped.
+    pub fn load(&mut self, counts: &[u32], count: u32) {
+        for (stopped_at, &n) in self.stopped_at.iter_mut().zip(counts) {
+            *stopped_at = if n < count { n } else { u32::MAX };
+        }
+    }
+
+    /// Stops the pixels where `stop` is true at `samples`; returns those newly stopped.
+    pub fn stop(&mut self, stop: &[bool], samples: u32) -> Vec<usize> {
+        assert_eq!(stop.len(), self.stopped_at.len(), "one flag per pixel");
+        let mut stopped = Vec::new();
+        for (i, (stopped_at, &s)) in self.stopped_at.iter_mut().zip(stop).enumerate() {
+            if s && *stopped_at == u32::MAX {
+                *stopped_at = samples;
+                stopped.push(i);
+            }
+        }
+        stopped
+    }
 }

@@ -141,6 +141,12 @@ pub fn merge(mut parts: Vec<Part>, allow_gaps: bool) -> Result<Merged, String> {
         settings: info.settings.clone(),
         scene: info.scene.clone(),
         device: devices.join(", "),
+        // The settings where every part has the same, none otherwise.
+        adaptive: parts
+            .iter()
+            .map(|p| p.partial.info.adaptive)
+            .reduce(|a, b| if a == b { a } else { None })
+            .flatten(),
     };
     Ok(Merged {
         partial: Partial {

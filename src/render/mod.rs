@@ -3,6 +3,7 @@
 //! count or the time limit is reached.
 
 pub mod accumulation;
+pub mod adaptive;
 pub mod bench;
 pub mod interrupt;
 pub mod merge;
@@ -12,6 +13,7 @@ use crate::image::aov::Aovs;
 use crate::image::output::Image;
 use crate::kernel::schedule::next_block_end;
 use crate::render::accumulation::Accumulation;
+use crate::render::adaptive::Adaptive;
 use anyhow::{anyhow, Result};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -31,20 +33,29 @@ pub trait Renderer {
     fn read_accumulation(&mut self) -> Result<Accumulation>;
     /// Replaces the accumulators with `state`, the statistics of the global samples
     /// `first_sample..first_sample + state.count` (none: empty); later samples continue after
-    /// them.
+    /// them. Its pixels with fewer than `state.count` samples were stopped and stay stopped.
     fn load_accumulation(&mut self, first_sample: u32, state: Option<&Accumulation>) -> Result<()>;
     /// The mean radiance per pixel.
     fn read_mean(&mut self) -> Result<Image>;
-    /// The variance of each pixel's mean estimate (σ²/n per channel, from the unbiased sample
-    /// variance); zero before two samples.
+    /// The variance of each pixel's mean estimate (σ²/n per channel, n the pixel's own count,
+    /// from the unbiased sample variance); zero before two samples.
     fn read_variance(&mut self) -> Result<Image>;
     /// The mean albedo, normal and depth per pixel, for the denoiser; an error unless the
     /// scene's `Params::aovs` asked for them.
     fn read_aovs(&mut self) -> Result<Aovs> {
         Err(anyhow!("this renderer does not accumulate AOVs"))
     }
-    /// Forgets all samples (the first sample stays where it was).
+    /// Forgets all samples (the first sample stays where it was); every pixel takes samples
+    /// again.
     fn reset(&mut self) -> Result<()>;
+    /// Adaptive sampling: the pixels where `stop` is true (one flag per pixel, row 0 at the
+    /// top) take no more samples; they keep their statistics and their count. A stopped pixel
+    /// stays stopped until a reset or a load.
+    fn stop_pixels(&mut self, stop: &[bool]) -> Result<()>;
+    /// Each pixel's own sample count: [`Renderer::samples`] unless it was stopped earlier.
+    fn pixel_counts(&self) -> Vec<u32>;
+    /// Pixels still taking samples.
+    fn active_pixels(&self) -> usize;
     /// Ray segments traced since the last reset (camera, bounce and shadow rays), where the
     /// renderer counts them (the GPU one only when instrumented).
     fn segments_traced(&self) -> Option<u64> {
@@ -69,6 +80,8 @@ pub fn check_size(params: &crate::kernel::types::Params, state: &Accumulation) -
     if (state.width, state.height) != (params.width, params.height)
         || state.mean.len() != pixels
         || state.m2.len() != pixels
+        || state.counts.len() != pixels
+        || state.counts.iter().any(|&n| n > state.count)
     {
         anyhow::bail!(
             "cannot load a {}×{} accumulation into a {}×{} render",
@@ -151,8 +164,12 @@ pub fn relative_error(mean: &Image, variance: &Image) -> Option<f64> {
 pub struct StopRules {
     /// Stop at the first batch boundary after this long.
     pub time_limit: Option<Duration>,
-    /// Stop at the first batch boundary where [`relative_error`] ≤ this.
+    /// Stop at the first batch boundary where [`relative_error`] ≤ this (unless `adaptive`,
+    /// which takes its own target).
     pub target_error: Option<f64>,
+    /// Adaptive sampling: pixels stop taking samples as they converge
+    /// (`src/render/adaptive.rs`), and the render stops when none is left.
+    pub adaptive: Option<Adaptive>,
     /// Stop before the next batch once this is set (by a signal handler).
     pub interrupted: Option<&'static AtomicBool>,
 }
@@ -167,6 +184,8 @@ pub struct BatchReport {
     pub render_time: Duration,
     pub last_batch_spp: u32,
     pub last_batch_time: Duration,
+    /// Pixels still taking samples (all of them unless adaptive sampling stopped some).
+    pub active_pixels: usize,
 }
 
 pub struct RenderStats {
@@ -191,6 +210,14 @@ pub fn render_progressive(
     let mut render_time = Duration::ZERO;
     let mut stop_reason = StopReason::SamplesReached;
     let mut error = None;
+    let first = renderer.first_sample();
+    // A resumed render at a checkpoint makes that checkpoint's decision again: the same one,
+    // from the same statistics.
+    if let Some(adaptive) = rules.adaptive {
+        if adaptive.is_checkpoint(first, renderer.samples()) {
+            stop_converged(renderer, &adaptive)?;
+        }
+    }
     while renderer.samples() < spp {
         if rules
             .interrupted
@@ -199,15 +226,26 @@ pub fn render_progressive(
             stop_reason = StopReason::Interrupted;
             break;
         }
+        if rules.adaptive.is_some() && renderer.active_pixels() == 0 {
+            stop_reason = StopReason::TargetError;
+            break;
+        }
         // Batches end only where the merge schedule's blocks do, so the image's bytes do not
         // depend on the batch sizes, which follow the wall clock (src/kernel/schedule.rs). The
         // blocks are of global sample indices, so a partial render's batches end where a
-        // single render's would.
-        let first = renderer.first_sample();
+        // single render's would. Adaptive sampling also ends one at each of its checkpoints.
         let done = first + renderer.samples();
-        let count = next_block_end(done, sizer.spp_per_batch, first + spp) - done;
+        let mut count = next_block_end(done, sizer.spp_per_batch, first + spp) - done;
+        if let Some(adaptive) = rules.adaptive {
+            count = count.min(adaptive.until_checkpoint(first, renderer.samples()));
+        }
         let batch_start = Instant::now();
         renderer.add_samples(count)?;
+        if let Some(adaptive) = rules.adaptive {
+            if adaptive.is_checkpoint(first, renderer.samples()) {
+                stop_converged(renderer, &adaptive)?;
+            }
+        }
         let took = batch_start.elapsed();
         render_time += took;
         let spp_done = renderer.samples();
@@ -215,6 +253,7 @@ pub fn render_progressive(
         if rules.target_error.is_some() && spp_done >= MIN_SPP_FOR_TARGET_ERROR {
             error = relative_error(&renderer.read_mean()?, &renderer.read_variance()?);
         }
+        let active_pixels = renderer.active_pixels();
         after_batch(
             renderer,
             &BatchReport {
@@ -224,12 +263,18 @@ pub fn render_progressive(
                 render_time,
                 last_batch_spp: count,
                 last_batch_time: took,
+                active_pixels,
             },
         )?;
         if spp_done >= spp {
             break;
         }
-        if let (Some(target), Some(e)) = (rules.target_error, error) {
+        if rules.adaptive.is_some() {
+            if renderer.active_pixels() == 0 {
+                stop_reason = StopReason::TargetError;
+                break;
+            }
+        } else if let (Some(target), Some(e)) = (rules.target_error, error) {
             if e <= target {
                 stop_reason = StopReason::TargetError;
                 break;
@@ -249,6 +294,14 @@ pub fn render_progressive(
         stop_reason,
         relative_error: error,
     })
+}
+
+/// Adaptive sampling's decision at a checkpoint: stops the pixels that have converged
+/// (`src/render/adaptive.rs`), from the accumulated statistics alone.
+pub fn stop_converged(renderer: &mut dyn Renderer, adaptive: &Adaptive) -> Result<()> {
+    let accumulation = renderer.read_accumulation()?;
+    let stop = adaptive::converged(&accumulation, adaptive.target_error);
+    renderer.stop_pixels(&stop)
 }
 
 /// Adds samples until there are `spp`, in batches of about `batch` (rounded up to the merge

@@ -4,10 +4,17 @@
 //! range it was asked for, the render's total spp, the seed, and a hash of the scene and of
 //! every setting that changes the image. Every EXR `glint render` writes is one, so any EXR
 //! render, interrupted or not, can be resumed or merged.
+//!
+//! Two versions: `glint-partial/1`, where every pixel holds every sample of the ranges, and
+//! `glint-partial/2`, written only where adaptive sampling stopped some pixels early, which
+//! adds each pixel's own sample count as the 32-bit unsigned channel `N`. Version 1 stays what
+//! it was, so glint of before adaptive sampling reads it; it refuses version 2 by its
+//! `glint.format`, rather than misread the counts. This glint reads both.
 
 use crate::kernel::types::{Params, PROJECTION_PERSPECTIVE};
 use crate::kernel::KernelScene;
 use crate::render::accumulation::Accumulation;
+use crate::render::adaptive::Adaptive;
 use crate::scene::{MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE};
 use anyhow::{Context, Result};
 use exr::prelude::{
@@ -20,8 +27,13 @@ use std::fmt::Write as _;
 use std::ops::Range;
 use std::path::Path;
 
-/// The format version; a reader refuses any other.
+/// The format version of files where every pixel holds every sample of its ranges.
 pub const FORMAT: &str = "glint-partial/1";
+/// The format version of files with per-pixel sample counts (the channel [`COUNT_CHANNEL`]);
+/// a reader refuses any version but these two.
+pub const FORMAT_COUNTS: &str = "glint-partial/2";
+/// Each pixel's own sample count, in version 2.
+const COUNT_CHANNEL: &str = "N";
 const MEAN_CHANNELS: [&str; 3] = ["R", "G", "B"];
 const M2_CHANNELS: [&str; 3] = ["M2.R", "M2.G", "M2.B"];
 /// Bidirectional renders: the camera strategies' own mean (RGB holds the image, splats
@@ -50,6 +62,9 @@ pub struct PartialInfo {
     pub scene: String,
     /// The device(s) that rendered it, for information only.
     pub device: String,
+    /// Adaptive sampling's settings, where it was on (`glint.adaptive`): a resume goes on
+    /// with them.
+    pub adaptive: Option<Adaptive>,
 }
 
 impl PartialInfo {
@@ -236,6 +251,15 @@ impl Partial {
                 }
             }
         }
+        let format = if a.is_uniform() {
+            FORMAT
+        } else {
+            channels.push(AnyChannel::new(
+                COUNT_CHANNEL,
+                FlatSamples::U32(a.counts.clone()),
+            ));
+            FORMAT_COUNTS
+        };
         let info = &self.info;
         let mut attributes = LayerAttributes::default();
         // UTF-8 bytes as they are: exr's Text::from panics beyond Latin-1 (a path may hold any).
@@ -244,8 +268,9 @@ impl Partial {
                 s.as_bytes(),
             )))
         };
+        let adaptive = info.adaptive.map(|a| ("glint.adaptive", a.to_header()));
         for (key, value) in [
-            ("glint.format", FORMAT.to_string()),
+            ("glint.format", format.to_string()),
             ("glint.samples", format_ranges(&info.ranges)),
             ("glint.target", format_range(&info.target)),
             ("glint.spp", info.spp.to_string()),
@@ -253,7 +278,10 @@ impl Partial {
             ("glint.settings", info.settings.clone()),
             ("glint.scene", info.scene.clone()),
             ("glint.device", info.device.clone()),
-        ] {
+        ]
+        .into_iter()
+        .chain(adaptive)
+        {
             attributes.other.insert(Text::from(key), text(&value));
         }
         if !a.splats.is_empty() {
@@ -308,9 +336,9 @@ impl Partial {
         let format = text_attribute(attributes, "glint.format").ok_or_else(|| {
             fail("not a glint partial render (no glint.format attribute; only EXR files written by glint render can be merged or resumed)".into())
         })?;
-        if format != FORMAT {
+        if format != FORMAT && format != FORMAT_COUNTS {
             return Err(fail(format!(
-                "glint.format is {format:?}; this glint reads {FORMAT:?}"
+                "glint.format is {format:?}; this glint reads {FORMAT:?} and {FORMAT_COUNTS:?}"
             )));
         }
         let get = |key: &str| {
@@ -335,6 +363,13 @@ impl Partial {
             settings: get("glint.settings")?,
             scene: get("glint.scene")?,
             device: get("glint.device")?,
+            adaptive: match text_attribute(attributes, "glint.adaptive") {
+                Some(text) => Some(
+                    Adaptive::from_header(&text)
+                        .map_err(|e| fail(format!("glint.adaptive: {e}")))?,
+                ),
+                None => None,
+            },
         };
         let last = info
             .ranges
@@ -434,10 +469,38 @@ impl Partial {
                 ));
             }
         }
+        let counts = if format == FORMAT_COUNTS {
+            let found = layer
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name == *COUNT_CHANNEL)
+                .ok_or_else(|| fail(format!("the channel {COUNT_CHANNEL} is missing")))?;
+            let counts = match &found.sample_data {
+                FlatSamples::U32(v) if v.len() == pixels => v.clone(),
+                _ => {
+                    return Err(fail(format!(
+                        "the channel {COUNT_CHANNEL} is not one 32-bit unsigned count per pixel"
+                    )))
+                }
+            };
+            if let Some(i) = counts.iter().position(|&n| n > count) {
+                return Err(fail(format!(
+                    "pixel ({}, {}) holds {} samples, more than the file's {count}",
+                    i % width,
+                    i / width,
+                    counts[i]
+                )));
+            }
+            counts
+        } else {
+            vec![count; pixels]
+        };
         let accumulation = Accumulation {
             width: width as u32,
             height: height as u32,
             count,
+            counts,
             mean: gather(if has_splats {
                 CAMERA_CHANNELS
             } else {

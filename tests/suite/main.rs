@@ -46,6 +46,7 @@ mod textures;
 mod transmission;
 
 // Lights, the environment and the integrator's statistics.
+mod adaptive;
 mod bdpt;
 mod chi2;
 mod closed_form;

@@ -21,6 +21,9 @@ pub struct PixelStats {
     pub nonfinite: u32,
     /// Mean albedo, normal and depth, when `params.aovs` asks for them.
     pub aov: AovMean,
+    /// Adaptive sampling has stopped the pixel: it takes no more samples (the kernel's flag in
+    /// the w of the pixel's M2).
+    pub stopped: bool,
 }
 
 /// The kernel's entry point for one pixel: `params.sample_count` samples starting at
@@ -36,6 +39,11 @@ pub fn render_pixel(
 ) -> u32 {
     let params = scene.params;
     let pixel = py * params.width + px;
+    // Adaptive sampling: a pixel the host has stopped takes no more samples (the kernel reads
+    // the flag the host sets in the pixel's M2: accumulate.wgsl's `pixel_stopped`).
+    if stats.stopped {
+        return 0;
+    }
     let mut acc = accumulator_start(params.accumulated_samples, stats.mean, stats.m2);
     let mut aov_mean = AovMean::default();
     let mut segments = 0;

@@ -8,7 +8,7 @@ use crate::image::output::Image;
 use crate::kernel::types::INTEGRATOR_BDPT;
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
-use crate::render::accumulation::Accumulation;
+use crate::render::accumulation::{Accumulation, PixelCounts};
 use crate::render::{check_size, Renderer};
 use anyhow::{anyhow, Result};
 use rayon::prelude::*;
@@ -18,6 +18,8 @@ pub struct CpuRenderer {
     stats: Vec<PixelStats>,
     /// Light tracing's splats (bidirectional path tracing only).
     film: SplatFilm,
+    /// Which pixels adaptive sampling has stopped, and at how many samples.
+    counts: PixelCounts,
     samples: u32,
     first_sample: u32,
     segments: u64,
@@ -30,17 +32,10 @@ impl CpuRenderer {
             scene: scene.clone(),
             stats: vec![PixelStats::default(); pixels],
             film: SplatFilm::new(pixels),
+            counts: PixelCounts::new(pixels),
             samples: 0,
             first_sample: 0,
             segments: 0,
-        }
-    }
-
-    fn image(&self, pixel: impl Fn(&PixelStats) -> [f32; 3] + Sync + Send) -> Image {
-        Image {
-            width: self.scene.params.width,
-            height: self.scene.params.height,
-            pixels: self.stats.par_iter().map(pixel).collect(),
         }
     }
 }
@@ -84,6 +79,7 @@ impl Renderer for CpuRenderer {
             width: self.scene.params.width,
             height: self.scene.params.height,
             count: self.samples,
+            counts: self.counts.counts(self.samples),
             mean: self.stats.iter().map(|s| s.mean.into()).collect(),
             m2: self.stats.iter().map(|s| s.m2.into()).collect(),
             splats: if self.scene.params.integrator == INTEGRATOR_BDPT {
@@ -105,6 +101,10 @@ impl Renderer for CpuRenderer {
             }
             self.samples = state.count;
             self.film.load(&state.splats);
+            self.counts.load(&state.counts, state.count);
+            for (i, stats) in self.stats.iter_mut().enumerate() {
+                stats.stopped = self.counts.is_stopped(i);
+            }
         }
         self.first_sample = first_sample;
         Ok(())
@@ -115,8 +115,17 @@ impl Renderer for CpuRenderer {
     }
 
     fn read_variance(&mut self) -> Result<Image> {
-        let n = self.samples;
-        Ok(self.image(|s| variance_of_mean(s.m2.into(), n)))
+        let counts = self.counts.counts(self.samples);
+        Ok(Image {
+            width: self.scene.params.width,
+            height: self.scene.params.height,
+            pixels: self
+                .stats
+                .iter()
+                .zip(counts)
+                .map(|(s, n)| variance_of_mean(s.m2.into(), n))
+                .collect(),
+        })
     }
 
     fn read_aovs(&mut self) -> Result<Aovs> {
@@ -142,6 +151,7 @@ impl Renderer for CpuRenderer {
     fn reset(&mut self) -> Result<()> {
         self.stats.fill(PixelStats::default());
         self.film.clear();
+        self.counts.reset();
         self.samples = 0;
         self.segments = 0;
         Ok(())
@@ -149,6 +159,21 @@ impl Renderer for CpuRenderer {
 
     fn segments_traced(&self) -> Option<u64> {
         Some(self.segments)
+    }
+
+    fn stop_pixels(&mut self, stop: &[bool]) -> Result<()> {
+        for i in self.counts.stop(stop, self.samples) {
+            self.stats[i].stopped = true;
+        }
+        Ok(())
+    }
+
+    fn pixel_counts(&self) -> Vec<u32> {
+        self.counts.counts(self.samples)
+    }
+
+    fn active_pixels(&self) -> usize {
+        self.counts.active()
     }
 
     fn nonfinite_samples(&self) -> u64 {
