@@ -291,6 +291,8 @@ pub fn render<'py>(
                 })
             })
             .transpose()?,
+        // The scene's own ([render] integrator); not a keyword of render() yet.
+        integrator: None,
     };
     let time_limit = match time_limit {
         Some(t) if !(0.0..=1e9).contains(&t) => {
