@@ -75,6 +75,15 @@ fn escapes(ray: Ray) -> bool {
     return closest_primitive(ray).t == NO_HIT;
 }
 
+// Whether nothing lies along `ray` before distance t_max (a shadow ray to a point).
+fn unoccluded_before(ray: Ray, t_max: f32) -> bool {
+    if USE_BVH {
+        // Any hit nearer than t_max ends the search (a target no primitive matches).
+        return bvh_traverse(bvh_ray(ray), t_max, t_max, 0u, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
+    }
+    return closest_primitive(ray).t >= t_max;
+}
+
 fn intersect_scene(ray: Ray) -> Hit {
     let closest = closest_primitive(ray);
     var hit: Hit;

@@ -73,11 +73,7 @@ fn punctual_visible(shadow: Ray, light: LightSample) -> bool {
         return escapes(shadow);
     }
     let t_light = dot(l.position - shadow.origin, shadow.dir);
-    if USE_BVH {
-        // Any hit nearer than the light ends the search (a target no primitive matches).
-        return bvh_traverse(bvh_ray(shadow), t_light, t_light, 0u, PRIMITIVE_ENVIRONMENT << PRIMITIVE_KIND_SHIFT).t == NO_HIT;
-    }
-    return closest_primitive(shadow).t >= t_light;
+    return unoccluded_before(shadow, t_light);
 }
 
 // Radiance of the sun disks a ray escaping along dir looks into. With `mis`, each is weighted
