@@ -1,6 +1,6 @@
 //! The buffers the render kernel writes and the host clears and reads back: per-pixel running
 //! mean and M2, the denoiser's AOVs, the segment and dropped-sample counters, the tile origin,
-//! and the readback buffers.
+//! bidirectional path tracing's splat film, and the readback buffers.
 
 use super::upload::Binding;
 
@@ -20,11 +20,26 @@ pub struct ImageBuffers {
     /// The kernel's count of dropped samples (one u32), read and cleared after every batch.
     pub nonfinite: wgpu::Buffer,
     pub nonfinite_readback: wgpu::Buffer,
+    /// Bidirectional path tracing's splat film (shaders/integrator/splat.wgsl: per pixel and
+    /// channel a 64-bit sum as two u32 words, low first) and its readback; `None` in kernels
+    /// without it.
+    pub splats: Option<SplatBuffers>,
+}
+
+pub struct SplatBuffers {
+    pub film: wgpu::Buffer,
+    pub readback: wgpu::Buffer,
 }
 
 impl ImageBuffers {
-    /// Accumulators of `accum_size` bytes and AOV buffers of `aov_size`.
-    pub fn new(device: &wgpu::Device, accum_size: u64, aov_size: u64) -> ImageBuffers {
+    /// Accumulators of `accum_size` bytes, AOV buffers of `aov_size`, and a splat film of
+    /// `splat_size` bytes where that is given.
+    pub fn new(
+        device: &wgpu::Device,
+        accum_size: u64,
+        aov_size: u64,
+        splat_size: Option<u64>,
+    ) -> ImageBuffers {
         // Buffers the kernel writes and the host clears and reads back.
         let read_write_buffer = |label, size| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -59,13 +74,17 @@ impl ImageBuffers {
             aovs: ["aov_albedo_depth", "aov_normal"]
                 .map(|label| read_write_buffer(label, aov_size)),
             readback: readback("readback", accum_size),
+            splats: splat_size.map(|size| SplatBuffers {
+                film: read_write_buffer("splats", size),
+                readback: readback("splat readback", size),
+            }),
         }
     }
 
     /// The kernel's bindings of these buffers.
     pub fn bindings(&self) -> Vec<Binding<'_>> {
         let read_write = wgpu::BufferBindingType::Storage { read_only: false };
-        vec![
+        let mut bindings = vec![
             (4, read_write, &self.mean),
             (5, read_write, &self.m2),
             (7, read_write, &self.counter),
@@ -73,6 +92,10 @@ impl ImageBuffers {
             (11, read_write, &self.aovs[1]),
             (16, read_write, &self.nonfinite),
             (17, wgpu::BufferBindingType::Uniform, &self.tile),
-        ]
+        ];
+        if let Some(splats) = &self.splats {
+            bindings.push((14, read_write, &splats.film));
+        }
+        bindings
     }
 }

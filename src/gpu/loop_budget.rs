@@ -68,10 +68,33 @@ pub fn loop_iterations_per_sample(scene: &KernelScene) -> u64 {
 /// primitive, a bound on a tree's nodes and candidates for any tree of at least two children
 /// per node.
 pub fn hardware_loop_iterations_per_sample(scene: &KernelScene) -> u64 {
+    sample_iterations(&scene.params, hardware_loop_iterations_per_ray(scene))
+}
+
+/// [`loop_iterations_per_ray`] for the hardware traversal (see
+/// [`hardware_loop_iterations_per_sample`]).
+pub fn hardware_loop_iterations_per_ray(scene: &KernelScene) -> u64 {
     let params = &scene.params;
     let primitives =
         params.sphere_count as u64 + params.quad_count as u64 + params.triangle_count as u64;
-    sample_iterations(params, 3 * primitives + 1)
+    3 * primitives + 1
+}
+
+/// The most loop iterations one bidirectional sample (shaders/integrator/bdpt/) can take, at
+/// `per_ray` per ray. With B = `max_bounces`: the camera subpath traces at most B + 1 rays and
+/// the light subpath B, and a ray that escapes looks for sun disks among the lights (twice:
+/// radiance and density). The joins: for each of the camera subpath's at most B + 2 vertices,
+/// a loop over the light vertices that make at most B scatterings with it, at most
+/// (B + 2)(B + 3) / 2 joins in all; each traces at most one shadow ray, looks among the lights
+/// for sun disks at most four times (densities at infinity), and weighs itself in two loops of
+/// at most B + 2 iterations together. Then the splat and the sample loops and the end's probe.
+pub fn bdpt_loop_iterations_per_sample(params: &Params, per_ray: u64) -> u64 {
+    let b = params.max_bounces as u64;
+    let lights = params.light_count as u64;
+    let walks = (2 * b + 1) * (per_ray + 2 * lights + 1);
+    let joins = (b + 2) * (b + 3) / 2;
+    let per_join = per_ray + 4 * lights + (b + 2) + 1;
+    walks + (b + 2) + joins * per_join + 1 + 2
 }
 
 fn sample_iterations(params: &Params, per_ray: u64) -> u64 {

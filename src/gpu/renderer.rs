@@ -7,7 +7,8 @@ use super::image_buffers::ImageBuffers;
 use super::inline_uniforms::params_binding_for;
 use super::instruments::Instruments;
 use super::loop_budget::{
-    device_loop_limit, hardware_loop_iterations_per_sample, loop_iterations_per_sample,
+    bdpt_loop_iterations_per_sample, device_loop_limit, hardware_loop_iterations_per_ray,
+    hardware_loop_iterations_per_sample, loop_iterations_per_ray, loop_iterations_per_sample,
     max_samples_per_dispatch, LAVAPIPE_LOOP_LIMIT,
 };
 use super::tiles::{next_tile, TilePlanner};
@@ -16,10 +17,10 @@ use super::upload::{check_storage_binding_count, ImageSizes, SceneBuffers};
 use crate::image::aov::Aovs;
 use crate::image::output::Image;
 use crate::kernel::source::{
-    render_kernel_source_with_texels, ParamsBinding, RENDER_ENTRY_POINT, WORKGROUP_SIZE,
+    entry_point_for, render_kernel_source_with_texels, ParamsBinding, WORKGROUP_SIZE,
 };
 use crate::kernel::texels::TexelBinding;
-use crate::kernel::types::Params;
+use crate::kernel::types::{Params, INTEGRATOR_BDPT};
 use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 use crate::kernel::KernelScene;
 use crate::render::accumulation::variance_of_mean;
@@ -146,11 +147,6 @@ impl<'a> GpuRenderer<'a> {
         variant: KernelVariant,
         window_bytes: u64,
     ) -> Result<GpuRenderer<'a>> {
-        if scene.params.integrator == crate::kernel::types::INTEGRATOR_BDPT {
-            return Err(anyhow!(
-                "the bdpt integrator runs on the CPU reference only so far (render with --cpu)"
-            ));
-        }
         if !variant.features.covers(&KernelFeatures::of(scene)) {
             return Err(anyhow!(
                 "the kernel variant {variant:?} lacks features the scene uses"
@@ -165,6 +161,13 @@ impl<'a> GpuRenderer<'a> {
         } else {
             16
         };
+        // The splat film: two u32 words per pixel and channel where the kernel renders
+        // bidirectionally, a placeholder where it only could (one with every feature).
+        let bdpt = params.integrator == INTEGRATOR_BDPT;
+        let splat_size = variant
+            .features
+            .bdpt
+            .then_some(if bdpt { pixel_count * 24 } else { 8 });
         let scene_buffers = SceneBuffers::upload(
             ctx,
             scene,
@@ -173,6 +176,7 @@ impl<'a> GpuRenderer<'a> {
             &ImageSizes {
                 accumulation: accum_size,
                 aov: aov_size,
+                splats: splat_size,
             },
         )?;
         let texel_binding = scene_buffers.texel_binding;
@@ -183,7 +187,7 @@ impl<'a> GpuRenderer<'a> {
                 | wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_DST,
         });
-        let images = ImageBuffers::new(device, accum_size, aov_size);
+        let images = ImageBuffers::new(device, accum_size, aov_size, splat_size);
         let read_only = wgpu::BufferBindingType::Storage { read_only: true };
         let params_binding = params_binding_for(&ctx.adapter_info);
         let params_type = match params_binding {
@@ -213,7 +217,7 @@ impl<'a> GpuRenderer<'a> {
         let (bind_group_layout, pipeline) = ctx.compute_pipeline(
             "glint render kernel",
             &render_kernel_source_with_texels(variant, params_binding, texel_binding),
-            RENDER_ENTRY_POINT,
+            entry_point_for(params.integrator),
             &compute_layout_entries(&buffers, tlas.map(|(binding, _)| binding)),
         );
         let bind_group = bind_group(device, "scene", &bind_group_layout, &buffers, tlas);
@@ -233,10 +237,16 @@ impl<'a> GpuRenderer<'a> {
             tiles: TilePlanner::new(SUBMISSION_TARGET),
             nonfinite: 0,
             loop_limit: device_loop_limit(&ctx.adapter_info),
-            loop_iterations: if variant.binding.uses_ray_queries() {
-                hardware_loop_iterations_per_sample(scene)
-            } else {
-                loop_iterations_per_sample(scene)
+            loop_iterations: match (bdpt, variant.binding.uses_ray_queries()) {
+                (false, false) => loop_iterations_per_sample(scene),
+                (false, true) => hardware_loop_iterations_per_sample(scene),
+                (true, false) => {
+                    bdpt_loop_iterations_per_sample(&params, loop_iterations_per_ray(scene))
+                }
+                (true, true) => bdpt_loop_iterations_per_sample(
+                    &params,
+                    hardware_loop_iterations_per_ray(scene),
+                ),
             },
             _acceleration: acceleration,
             texel_binding,
@@ -339,6 +349,11 @@ impl<'a> GpuRenderer<'a> {
                 "set_params cannot turn on AOVs compiled out of the kernel; make a new renderer"
             ));
         }
+        if params.integrator != self.params.integrator {
+            return Err(anyhow!(
+                "set_params cannot change the integrator (its kernel's entry point); make a new renderer"
+            ));
+        }
         if params.light_sampling != 0 && !self.variant.features.light_sampling {
             return Err(anyhow!(
                 "set_params cannot turn on light sampling compiled out of the kernel; make a new renderer"
@@ -346,6 +361,28 @@ impl<'a> GpuRenderer<'a> {
         }
         self.params = params;
         self.reset()
+    }
+
+    /// Whether the kernel renders bidirectionally (and splats).
+    fn is_bdpt(&self) -> bool {
+        self.params.integrator == INTEGRATOR_BDPT
+    }
+
+    /// The splat film's 64-bit sums (shaders/integrator/splat.wgsl: two u32 words each, low
+    /// first, so the bytes are little-endian u64s); empty for path tracing.
+    fn read_splats(&self) -> Result<Vec<u64>> {
+        let Some(splats) = self.images.splats.as_ref().filter(|_| self.is_bdpt()) else {
+            return Ok(Vec::new());
+        };
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&splats.film, 0, &splats.readback, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.ctx.read_mapped(&splats.readback, |bytes| {
+            bytes
+                .chunks_exact(8)
+                .map(|w| u64::from_le_bytes(w.try_into().expect("8 bytes")))
+                .collect()
+        })
     }
 
     /// Each vec4 of `buffer`, which is at most as large as the readback buffer.
@@ -522,8 +559,8 @@ impl Renderer for GpuRenderer<'_> {
             counts: self.counts.counts(self.samples),
             mean: self.read_vec3s(&self.images.mean)?,
             m2: self.read_vec3s(&self.images.m2)?,
-            splats: Vec::new(),
-            splat_scale: 0.0,
+            splats: self.read_splats()?,
+            splat_scale: self.params.splat_scale,
         })
     }
 
@@ -550,6 +587,17 @@ impl Renderer for GpuRenderer<'_> {
                 0,
                 bytemuck::cast_slice(&vec4s(&state.m2, &stopped)),
             );
+            if let Some(splats) = self.images.splats.as_ref().filter(|_| self.is_bdpt()) {
+                let pixels = self.params.width as usize * self.params.height as usize;
+                if !state.splats.is_empty() && state.splats.len() != 3 * pixels {
+                    return Err(anyhow!(
+                        "the splat film holds {} sums, not the 3 per pixel of {pixels} pixels",
+                        state.splats.len()
+                    ));
+                }
+                let bytes: Vec<u8> = state.splats.iter().flat_map(|w| w.to_le_bytes()).collect();
+                queue.write_buffer(&splats.film, 0, &bytes);
+            }
             self.samples = state.count;
         }
         self.first_sample = first_sample;
@@ -561,6 +609,10 @@ impl Renderer for GpuRenderer<'_> {
     }
 
     fn read_mean(&mut self) -> Result<Image> {
+        if self.is_bdpt() {
+            // The camera strategies' mean and the splats over the samples per pixel.
+            return Ok(self.read_accumulation()?.mean_image());
+        }
         Ok(self.image(self.read_vec3s(&self.images.mean)?))
     }
 
@@ -596,6 +648,9 @@ impl Renderer for GpuRenderer<'_> {
         encoder.clear_buffer(&self.images.m2, 0, None);
         encoder.clear_buffer(&self.images.counter, 0, None);
         encoder.clear_buffer(&self.images.nonfinite, 0, None);
+        if let Some(splats) = &self.images.splats {
+            encoder.clear_buffer(&splats.film, 0, None);
+        }
         self.ctx.queue.submit([encoder.finish()]);
         self.samples = 0;
         self.counts.reset();

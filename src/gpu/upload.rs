@@ -90,6 +90,8 @@ const WINDOW_LABELS: [&str; 4] = [
 pub struct ImageSizes {
     pub accumulation: u64,
     pub aov: u64,
+    /// The splat film's bytes, in kernels that have one (bidirectional path tracing).
+    pub splats: Option<u64>,
 }
 
 /// The scene's arrays and the energy tables in GPU buffers, bound as the kernel `variant`
@@ -351,6 +353,12 @@ impl SceneBuffers {
                 BufferNeed::new("aov_normal", images.aov, BufferBinding::Storage),
             ]
             .into_iter()
+            .chain(images.splats.into_iter().flat_map(|bytes| {
+                [
+                    BufferNeed::new("splats", bytes, BufferBinding::Storage),
+                    BufferNeed::new("splat readback", bytes, BufferBinding::Unbound),
+                ]
+            }))
             .chain(texel_needs)
             .collect::<Vec<_>>(),
         )?;

@@ -187,6 +187,36 @@ pub const SHADER_PARTS: [(&str, &str); 45] = [
     ),
 ];
 
+/// Bidirectional path tracing's parts, in dependency order after [`SHADER_PARTS`]: only in
+/// kernels with [`KernelFeatures::bdpt`], so that path tracing kernels neither hold nor
+/// compile them. Their entry point is [`BDPT_ENTRY_POINT`].
+pub const BDPT_PARTS: [(&str, &str); 6] = [
+    (
+        "lights/emission.wgsl",
+        include_str!("../../shaders/lights/emission.wgsl"),
+    ),
+    (
+        "integrator/splat.wgsl",
+        include_str!("../../shaders/integrator/splat.wgsl"),
+    ),
+    (
+        "integrator/bdpt/vertex.wgsl",
+        include_str!("../../shaders/integrator/bdpt/vertex.wgsl"),
+    ),
+    (
+        "integrator/bdpt/walk.wgsl",
+        include_str!("../../shaders/integrator/bdpt/walk.wgsl"),
+    ),
+    (
+        "integrator/bdpt/connect.wgsl",
+        include_str!("../../shaders/integrator/bdpt/connect.wgsl"),
+    ),
+    (
+        "integrator/bdpt/mod.wgsl",
+        include_str!("../../shaders/integrator/bdpt/mod.wgsl"),
+    ),
+];
+
 const SCENE_STORAGE: &str = include_str!("../../shaders/core/scene_storage.wgsl");
 /// The hardware traversal (ray queries), in the hardware variant only.
 const TRAVERSE_HARDWARE: &str = include_str!("../../shaders/traverse/hardware.wgsl");
@@ -200,6 +230,19 @@ const SCENE_UNIFORM: &str = include_str!("../../shaders/core/scene_uniform.wgsl"
 
 /// Name of the compute entry point in `shaders/integrator/path.wgsl`.
 pub const RENDER_ENTRY_POINT: &str = "render";
+
+/// Name of bidirectional path tracing's entry point, in `shaders/integrator/bdpt/mod.wgsl`
+/// (kernels with [`KernelFeatures::bdpt`] only).
+pub const BDPT_ENTRY_POINT: &str = "render_bdpt";
+
+/// The entry point that renders with `integrator` (`Params::integrator`).
+pub fn entry_point_for(integrator: u32) -> &'static str {
+    if integrator == crate::kernel::types::INTEGRATOR_BDPT {
+        BDPT_ENTRY_POINT
+    } else {
+        RENDER_ENTRY_POINT
+    }
+}
 
 /// Workgroup size of the render kernel, as declared in `shaders/integrator/path.wgsl`.
 pub const WORKGROUP_SIZE: (u32, u32) = (8, 8);
@@ -341,7 +384,12 @@ pub fn render_kernel_source_with_texels(
     if variant.binding.uses_ray_queries() {
         source += "enable wgpu_ray_query;\n";
     }
-    for (i, (name, text)) in SHADER_PARTS.iter().enumerate() {
+    let bdpt_parts: &[(&str, &str)] = if variant.features.bdpt {
+        &BDPT_PARTS
+    } else {
+        &[]
+    };
+    for (i, (name, text)) in SHADER_PARTS.iter().chain(bdpt_parts).enumerate() {
         source += &format!("// ---- {name}\n{text}\n");
         if i == 0 {
             source += &format!(

@@ -3,9 +3,9 @@
 
 use crate::kernel::bvh::layout::BvhLayout;
 use crate::kernel::types::{
-    BvhNode, BvhWideNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, LIGHT_SUN,
-    MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
-    PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
+    BvhNode, BvhWideNode, Emitter, Material, Quad, Sphere, ALPHA_OPAQUE, INTEGRATOR_BDPT,
+    LIGHT_SUN, MATERIAL_DIELECTRIC, MATERIAL_METAL, MATERIAL_PBR, NO_TEXTURE, PRIMITIVE_LIGHT,
+    PRIMITIVE_QUAD, PRIMITIVE_SPHERE, PRIMITIVE_TRIANGLE,
 };
 use crate::kernel::KernelScene;
 
@@ -229,6 +229,12 @@ pub struct KernelFeatures {
     /// Participating media (shaders/media/, shaders/integrator/path_media.wgsl): free flights,
     /// medium vertices, interfaces and shadow rays through them.
     pub media: bool,
+    /// Bidirectional path tracing (shaders/integrator/bdpt/, shaders/lights/emission.wgsl,
+    /// shaders/integrator/splat.wgsl) and its entry point, for scenes rendered with
+    /// `Params::integrator` = `INTEGRATOR_BDPT`; compiled out of path tracing's kernels. Its
+    /// next-event estimation and light paths reach every emitter, light sampling or not, so
+    /// [`KernelFeatures::of`] compiles the lights in wherever the scene has them.
+    pub bdpt: bool,
 }
 
 impl KernelFeatures {
@@ -255,6 +261,7 @@ impl KernelFeatures {
         instances: true,
         texcoord1: true,
         media: true,
+        bdpt: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -262,6 +269,7 @@ impl KernelFeatures {
         let emits = |primitive| scene.emitters.iter().any(|e| e.primitive == primitive);
         let has_kind = |kind| scene.materials.iter().any(|m| m.kind == kind);
         let light_sampling = scene.params.light_sampling != 0 && !scene.emitters.is_empty();
+        let bdpt = scene.params.integrator == INTEGRATOR_BDPT;
         KernelFeatures {
             light_sampling,
             sphere_emitters: emits(PRIMITIVE_SPHERE),
@@ -286,7 +294,7 @@ impl KernelFeatures {
             aovs: scene.params.aovs != 0,
             textures: !scene.textures.is_empty(),
             environment: scene.params.environment_width > 0,
-            lights: light_sampling && emits(PRIMITIVE_LIGHT),
+            lights: (light_sampling || bdpt) && emits(PRIMITIVE_LIGHT),
             sun_disks: scene
                 .lights
                 .iter()
@@ -296,6 +304,36 @@ impl KernelFeatures {
             instances: !scene.instances.is_empty(),
             texcoord1: !scene.triangle_uvs1.is_empty(),
             media: scene.params.medium_count > 0,
+            bdpt,
+        }
+    }
+
+    /// The features of both: a kernel for every scene either serves (tests share one kernel
+    /// between scenes so).
+    pub fn union(&self, other: &KernelFeatures) -> KernelFeatures {
+        KernelFeatures {
+            light_sampling: self.light_sampling || other.light_sampling,
+            sphere_emitters: self.sphere_emitters || other.sphere_emitters,
+            quad_emitters: self.quad_emitters || other.quad_emitters,
+            triangle_emitters: self.triangle_emitters || other.triangle_emitters,
+            metal: self.metal || other.metal,
+            dielectric: self.dielectric || other.dielectric,
+            pbr: self.pbr || other.pbr,
+            transmission: self.transmission || other.transmission,
+            clearcoat: self.clearcoat || other.clearcoat,
+            sheen: self.sheen || other.sheen,
+            volume: self.volume || other.volume,
+            aovs: self.aovs || other.aovs,
+            textures: self.textures || other.textures,
+            environment: self.environment || other.environment,
+            lights: self.lights || other.lights,
+            sun_disks: self.sun_disks || other.sun_disks,
+            alpha: self.alpha || other.alpha,
+            vertex_colors: self.vertex_colors || other.vertex_colors,
+            instances: self.instances || other.instances,
+            texcoord1: self.texcoord1 || other.texcoord1,
+            media: self.media || other.media,
+            bdpt: self.bdpt || other.bdpt,
         }
     }
 
@@ -323,6 +361,7 @@ impl KernelFeatures {
             && needs(self.instances, other.instances)
             && needs(self.texcoord1, other.texcoord1)
             && needs(self.media, other.media)
+            && needs(self.bdpt, other.bdpt)
     }
 }
 

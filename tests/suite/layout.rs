@@ -313,6 +313,10 @@ fn wgsl_constants_match_the_hosts() {
     use glint::kernel::types as t;
     use glint::tables::clearcoat as c;
     use glint::tables::ggx as g;
+    // Bidirectional path tracing's (in the kernel with every feature).
+    use glint::cpu::integrator::bdpt::vertex as v;
+    use glint::cpu::integrator::bdpt::walk as w;
+    use glint::cpu::lights::emission as e;
     for (name, value) in [
         ("MATERIAL_DIFFUSE", t::MATERIAL_DIFFUSE),
         ("MATERIAL_SPECULAR", t::MATERIAL_SPECULAR),
@@ -340,6 +344,21 @@ fn wgsl_constants_match_the_hosts() {
         ),
         ("CLEARCOAT_ENERGY_SIZE", c::CLEARCOAT_ENERGY_SIZE as u32),
         ("CLEARCOAT_ENERGY_PART", c::CLEARCOAT_ENERGY_PART as u32),
+        ("INTEGRATOR_PATH", t::INTEGRATOR_PATH),
+        ("INTEGRATOR_BDPT", t::INTEGRATOR_BDPT),
+        ("EMITTER_AREA", e::EMITTER_AREA),
+        ("EMITTER_POINT", e::EMITTER_POINT),
+        ("EMITTER_INFINITE", e::EMITTER_INFINITE),
+        ("EMITTER_DELTA_DIRECTION", e::EMITTER_DELTA_DIRECTION),
+        ("VERTEX_CAMERA", v::VERTEX_CAMERA),
+        ("VERTEX_LIGHT", v::VERTEX_LIGHT),
+        ("VERTEX_SURFACE", v::VERTEX_SURFACE),
+        ("BDPT_MAX_BOUNCES", w::BDPT_MAX_BOUNCES),
+        ("CAMERA_VERTICES", w::CAMERA_VERTICES as u32),
+        ("LIGHT_VERTICES", w::LIGHT_VERTICES as u32),
+        ("LIGHT_SUBPATH", w::LIGHT_SUBPATH),
+        ("LIGHT_SEGMENTS", w::LIGHT_SEGMENTS),
+        ("CONNECTION_SEGMENTS", w::CONNECTION_SEGMENTS),
     ] {
         assert_eq!(constant(name), value, "{name}");
     }
@@ -456,6 +475,8 @@ fn every_feature_combination_validates() {
             instances: (bits * 17 / 11) % 2 == 1,
             // Likewise, with and without light sampling, lights and dielectrics.
             media: (bits * 19 / 13) % 2 == 1,
+            // Likewise, with and without lights, the environment, textures and triangles.
+            bdpt: (bits * 23 / 17) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -504,6 +525,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         texcoord1: false,
         instances: false,
         media: false,
+        bdpt: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

@@ -1,6 +1,8 @@
 //! The kernel's entry point for one pixel (WGSL side: the `render` entry point of
-//! `shaders/integrator/pixel.wgsl`): its samples, by the integrator `Params::integrator`
-//! names, merged into its statistics.
+//! `shaders/integrator/path.wgsl` for path tracing, `render_bdpt` of
+//! `shaders/integrator/bdpt/mod.wgsl` for bidirectional: the kernel compiles the integrator
+//! in, where this branches on it): its samples, by the integrator `Params::integrator` names,
+//! merged into its statistics.
 
 use crate::cpu::integrator::accumulate::{accumulator_start, add_sample, merge_block};
 use crate::cpu::integrator::aov::{aov_mean_add, aov_merge, aov_start, aovs_on, AovMean};
