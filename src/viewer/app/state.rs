@@ -112,6 +112,10 @@ impl App {
         let mut params = self.kernel.params;
         place_camera(&mut params, &self.camera);
         params.aovs = self.aovs as u32;
+        // The window shows the kernel's mean buffer as it runs, and bidirectional path tracing
+        // keeps its light tracing in a splat film beside it: the viewer previews with path
+        // tracing, the same image in expectation (`run` says so).
+        params.integrator = crate::kernel::types::INTEGRATOR_PATH;
         params
     }
 
