@@ -159,7 +159,8 @@ fn open_gpu(args: &RenderArgs, integrator: Integrator) -> Result<Option<GpuConte
         return Ok(None);
     }
     if integrator == Integrator::Bdpt && !args.gpu {
-        // Not in the kernel yet: the CPU reference renders it.
+        // The kernel renders it, but on lavapipe no faster than the CPU reference
+        // (docs/src/reference/integrators.md, "On the GPU"): the CPU unless --gpu asks.
         return Ok(None);
     }
     match GpuContext::new() {
