@@ -305,3 +305,97 @@ fn bdpt_renders_are_reproducible_and_merge_exactly() {
     assert_eq!(merged.splats, once.splats);
     assert_eq!(merged.mean_image().pixels, once.mean_image().pixels);
 }
+
+/// A floor and a wall meeting at a right angle, nothing else: every join between a point of
+/// one and a point of the other is clear. Their points are exact along their normals (the
+/// planes are y = 0 and z = 4), so their error bounds and offsets are 0, and a join that
+/// searched its full length met the far surface itself by rounding: measured before the join
+/// stopped short of its end, 4.5% of the joins from the wall to the floor, and bidirectional
+/// renders of such a room 0.3–0.5% too dark on the wall. Deterministic: no join may fail.
+#[test]
+fn joins_between_two_open_surfaces_are_never_blocked() {
+    use glam::Vec3;
+    use glint::cpu::core::ray::Ray;
+    use glint::cpu::geometry::intersect::intersect_scene;
+    use glint::cpu::integrator::bdpt::connect::segment_clear;
+    use glint::cpu::integrator::bdpt::vertex::VERTEX_SURFACE;
+    use glint::cpu::integrator::bdpt::walk::blank_vertex;
+    let scene = common::kernel_scene(
+        r#"
+[camera]
+eye = [0.0, 2.4, -7.0]
+target = [0.0, 0.7, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40.0
+[render]
+width = 8
+height = 8
+spp = 1
+max_bounces = 2
+[materials.grey]
+type = "diffuse"
+color = [0.7, 0.7, 0.7]
+[[quads]]
+corner = [-4.5, 0.0, -3.0]
+u = [0.0, 0.0, 7.0]
+v = [9.0, 0.0, 0.0]
+material = "grey"
+[[quads]]
+corner = [-4.5, 0.0, 4.0]
+u = [9.0, 0.0, 0.0]
+v = [0.0, 4.0, 0.0]
+material = "grey"
+[[lights]]
+type = "point"
+position = [2.4, 1.6, -0.6]
+intensity = 12.0
+"#,
+    );
+    let refs = SceneRefs::of(&scene, &scene.params);
+    let eye = Vec3::new(0.0, 2.4, -7.0);
+    // Points where rays from the eye meet each surface, as a camera subpath finds them.
+    let vertices_towards = |targets: Vec<Vec3>| -> Vec<_> {
+        targets
+            .into_iter()
+            .map(|target| {
+                let dir = (target - eye).normalize();
+                let hit = intersect_scene(&refs.geometry, &Ray { origin: eye, dir });
+                assert!(hit.t.is_finite(), "the ray towards {target} misses");
+                let mut v = blank_vertex();
+                v.kind = VERTEX_SURFACE;
+                v.hit = hit;
+                v.dir = -dir;
+                v
+            })
+            .collect()
+    };
+    let grid = |f: &dyn Fn(f32, f32) -> Vec3| -> Vec<Vec3> {
+        (0..24)
+            .flat_map(|i| (0..24).map(move |j| (i, j)))
+            .map(|(i, j)| f((i as f32 + 0.37) / 24.0, (j as f32 + 0.61) / 24.0))
+            .collect()
+    };
+    let wall = vertices_towards(grid(&|a, b| Vec3::new(-4.4 + 8.8 * a, 0.05 + 3.9 * b, 4.0)));
+    let floor = vertices_towards(grid(&|a, b| Vec3::new(-4.4 + 8.8 * a, 0.0, -2.9 + 6.8 * b)));
+    let id = SampleId {
+        pixel: 0,
+        px: 0,
+        py: 0,
+        sample: 0,
+    };
+    let mut blocked = 0;
+    for w in &wall {
+        for f in &floor {
+            // Both ways: a camera vertex on the wall joined to a light vertex on the floor,
+            // and the reverse.
+            blocked += !segment_clear(&refs, w, f, id, 2, 2) as usize;
+            blocked += !segment_clear(&refs, f, w, id, 2, 2) as usize;
+        }
+    }
+    assert_eq!(
+        blocked,
+        0,
+        "{blocked} of {} joins blocked in an empty room",
+        2 * wall.len() * floor.len()
+    );
+}
