@@ -66,6 +66,7 @@ def render(
     seed=None,
     light_sampling=None,
     sampler=None,
+    integrator=None,
     device="auto",
     traversal="auto",
     variance=False,
@@ -79,8 +80,9 @@ def render(
 
     The keyword arguments are `glint render`'s overrides, with the same names and meanings:
     spp, width, height, max_bounces, seed, light_sampling (True/False or "on"/"off"), sampler
-    ("independent" or "sobol"); None keeps the scene's value. device is "auto" (the GPU if there is one, else the CPU
-    reference), "gpu" (or a RuntimeError) or "cpu". time_limit (seconds) stops at the first
+    ("independent" or "sobol"), integrator ("path" or "bdpt"); None keeps the scene's value.
+    device is "auto" (the GPU if there is one, else the CPU reference; bdpt renders on the CPU
+    reference, as `glint render` does without --gpu), "gpu" (or a RuntimeError) or "cpu". time_limit (seconds) stops at the first
     batch boundary after it; progress prints the sample count on stderr. denoise=True runs
     Open Image Denoise on the result as `glint render --denoise` does (a RuntimeError with
     the install step when OIDN is missing).
@@ -122,6 +124,7 @@ def render(
         seed=_integer("seed", seed),
         light_sampling=_on_off(light_sampling),
         sampler=sampler,
+        integrator=integrator,
         device=device,
         traversal=traversal,
         variance=bool(variance),

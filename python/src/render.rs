@@ -13,7 +13,8 @@ use glint::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
 use glint::kernel::KernelScene;
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use glint::scene::{
-    self as scenes, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+    self as scenes, Integrator, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE,
+    MAX_SPP,
 };
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -251,7 +252,7 @@ fn run_gpu(
 /// the image and the other outputs as H×W×3 float32 NumPy arrays, and the statistics.
 #[pyfunction]
 #[pyo3(signature = (scene, *, spp=None, width=None, height=None, max_bounces=None, seed=None,
-    light_sampling=None, sampler=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
+    light_sampling=None, sampler=None, integrator=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
     time_limit=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
@@ -264,6 +265,7 @@ pub fn render<'py>(
     seed: Option<i64>,
     light_sampling: Option<bool>,
     sampler: Option<&str>,
+    integrator: Option<&str>,
     device: &str,
     traversal: &str,
     variance: bool,
@@ -291,8 +293,15 @@ pub fn render<'py>(
                 })
             })
             .transpose()?,
-        // The scene's own ([render] integrator); not a keyword of render() yet.
-        integrator: None,
+        integrator: integrator
+            .map(|s| {
+                Integrator::from_name(s).ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "integrator: expected \"path\" or \"bdpt\", got {s:?}"
+                    ))
+                })
+            })
+            .transpose()?,
     };
     let time_limit = match time_limit {
         Some(t) if !(0.0..=1e9).contains(&t) => {
@@ -314,6 +323,14 @@ pub fn render<'py>(
         .clone()
         .with_overrides(&overrides)
         .map_err(|m| PyValueError::new_err(format!("{source}: {m}")))?;
+    let bdpt = validated.render.integrator == Integrator::Bdpt;
+    if bdpt && variance {
+        // As `glint render --variance` refuses it: light tracing's splats make pixels depend
+        // on one another, which the per-pixel variance assumes they do not.
+        return Err(PyValueError::new_err(
+            "variance: not available with the bdpt integrator yet (its splats make pixels depend on one another)",
+        ));
+    }
     let mut kernel_scene = validated
         .try_kernel_scene()
         .map_err(|e| SceneError::new_err(format!("{source}: {e}")))?;
@@ -333,6 +350,8 @@ pub fn render<'py>(
         let stop = StopFlag::take();
         let gpu = match device {
             Device::Cpu => None,
+            // As `glint render` without --gpu: bidirectional runs on the CPU reference.
+            Device::Auto if bdpt => None,
             _ => match gpu_context() {
                 Ok(ctx) => Some(ctx),
                 Err(e) if device == Device::Gpu => {
@@ -383,6 +402,7 @@ pub fn render<'py>(
     stats.set_item("seed", r.seed)?;
     stats.set_item("light_sampling", r.light_sampling)?;
     stats.set_item("sampler", r.sampler.name())?;
+    stats.set_item("integrator", r.integrator.name())?;
     stats.set_item("paths", paths)?;
     stats.set_item("seconds", rendered.seconds)?;
     stats.set_item(

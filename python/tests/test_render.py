@@ -34,6 +34,25 @@ def test_cpu_render_equals_the_cli_exr_bit_for_bit(cli, cornell, tmp_path):
     assert result.stats["device"] == "cpu"
 
 
+def test_bdpt_render_equals_the_cli_exr_bit_for_bit(cli, root, tmp_path):
+    scene = root / "scenes" / "cornell-glass.toml"
+    out = tmp_path / "cli.exr"
+    settings = dict(SETTINGS, integrator="bdpt")
+    cli("render", scene, "--cpu", *cli_flags(settings), "-o", out)
+    # device="auto" renders bdpt on the CPU reference, as the command does without --gpu.
+    result = glint.render(glint.load(scene), full=True, **settings)
+    assert result.stats["integrator"] == "bdpt"
+    assert result.stats["device"] == "cpu"
+    assert np.array_equal(result.image.view(np.uint32), glint.read(out).view(np.uint32))
+    path = glint.render(glint.load(scene), device="cpu", full=True, **dict(settings, integrator="path"))
+    assert path.stats["integrator"] == "path"
+    assert not np.array_equal(path.image, result.image)
+    with pytest.raises(ValueError, match="integrator"):
+        glint.render(glint.load(scene), integrator="mlt")
+    with pytest.raises(ValueError, match="bdpt"):
+        glint.render(glint.load(scene), integrator="bdpt", variance=True, spp=1)
+
+
 def test_render_returns_a_plain_array_unless_asked_for_more(cornell):
     img = glint.render(glint.load(cornell), device="cpu", **SETTINGS)
     assert isinstance(img, np.ndarray) and img.shape == (16, 20, 3)

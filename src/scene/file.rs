@@ -148,6 +148,12 @@ pub(super) struct MaterialToml {
     pub(super) clearcoat_roughness: Option<S<RoughnessToml>>,
     pub(super) sheen_color: Option<S<Triple>>,
     pub(super) sheen_roughness: Option<S<RoughnessToml>>,
+    /// Random-walk subsurface scattering, for `type = "pbr"`: the colour the material takes
+    /// after many scatterings inside, and the mean free path (one length, or one per
+    /// channel); a medium made from them fills every sphere and closed mesh of the material
+    /// (`src/scene/validate/media.rs`, `subsurface_media`).
+    pub(super) subsurface_color: Option<S<Triple>>,
+    pub(super) subsurface_radius: Option<S<toml::Value>>,
     /// The coat's own tangent-space normal map (glTF's clearcoatNormalTexture), in the forms
     /// of `normal_map`.
     pub(super) clearcoat_normal_map: Option<S<toml::Value>>,

@@ -432,6 +432,35 @@ fn uniform_scene_kernel_declares_the_uploaded_sizes() {
     }
 }
 
+/// A kernel without media carries none of the media's code, only media/no_media.wgsl's stubs:
+/// behind a constant `false`, lavapipe still translated and inlined it for every kernel it built
+/// (docs/src/performance/history/2026-12-04-media-free-cost.md).
+#[test]
+fn kernels_without_media_carry_only_the_media_stubs() {
+    let source = |media| {
+        render_kernel_source_for(KernelVariant {
+            binding: SceneBinding::Storage,
+            features: KernelFeatures {
+                media,
+                ..KernelFeatures::ALL
+            },
+        })
+    };
+    let (with, without) = (source(true), source(false));
+    for part in [
+        "// ---- media/phase.wgsl",
+        "// ---- media/medium.wgsl",
+        "// ---- integrator/path_media.wgsl",
+        "fn sample_free_flight(",
+        "fn hg_phase(",
+    ] {
+        assert!(with.contains(part), "{part} missing with media");
+        assert!(!without.contains(part), "{part} present without media");
+    }
+    assert!(without.contains("// ---- media/no_media.wgsl"));
+    assert!(!with.contains("// ---- media/no_media.wgsl"));
+}
+
 /// Every combination of compiled-out features gives a valid kernel, in every binding.
 #[test]
 fn every_feature_combination_validates() {

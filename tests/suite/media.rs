@@ -280,3 +280,57 @@ fn white_furnace_media_vanish_under_a_uniform_map() {
         }
     }
 }
+
+/// `subsurface_color` and `subsurface_radius` on a pbr material: a medium inside every sphere of
+/// it, its coefficients Chiang, Kutz and Burley's fit (src/scene/validate/media.rs), the surface
+/// fully transmissive; and a render through it is finite and lit.
+#[test]
+fn a_subsurface_material_fills_its_spheres_with_the_fitted_medium() {
+    let text = r#"
+[camera]
+eye = [0.0, 1.0, -4.0]
+target = [0.0, 0.6, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 30.0
+[render]
+width = 12
+height = 12
+spp = 16
+max_bounces = 32
+background = [1.0, 1.0, 1.0]
+[materials.wax]
+type = "pbr"
+base_color = [1.0, 1.0, 1.0]
+subsurface_color = [0.5, 0.5, 0.5]
+subsurface_radius = [1.0, 0.5, 2.0]
+[[spheres]]
+center = [0.0, 0.6, 0.0]
+radius = 0.6
+material = "wax"
+"#;
+    let scene = Scene::parse(text, Path::new("wax.toml")).unwrap();
+    assert_eq!(scene.media.list.len(), 1);
+    assert_eq!(scene.media.boundaries.len(), 1);
+    let medium = &scene.media.list[0];
+    // A = 0.5: α = 1 − exp(0.5 (−5.09406 + 0.5 (2.61188 − 0.5 · 4.31805))) = 0.912298;
+    // σt = 1 / (d (1.9 − 0.5 + 3.5 · 0.3²)) = 0.583090 / d.
+    for (c, d) in [1.0f32, 0.5, 2.0].into_iter().enumerate() {
+        let extinction = medium.sigma_a[c] + medium.sigma_s[c];
+        assert!((extinction * d - 0.583090).abs() < 1e-5, "{medium:?}");
+        assert!(
+            (medium.sigma_s[c] / extinction - 0.912298).abs() < 1e-5,
+            "{medium:?}"
+        );
+    }
+    let (material, _) = scene.media.boundaries[0];
+    assert!(matches!(
+        scene.materials[material as usize].kind,
+        glint::scene::MaterialKind::Pbr { transmission, .. } if transmission == 1.0
+    ));
+    let image = common::render_cpu(&scene.kernel_scene(), 16);
+    let center = image.pixels[6 * 12 + 6];
+    assert!(
+        center.iter().all(|v| v.is_finite() && *v > 0.0),
+        "{center:?}"
+    );
+}

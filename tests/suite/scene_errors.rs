@@ -667,3 +667,53 @@ fn an_interface_takes_no_ior_nor_colour() {
         &["materials.white.ior", "no ior nor color"],
     );
 }
+
+/// `GOOD` with the sphere's material a pbr one given `fields` (subsurface scattering).
+fn with_subsurface(fields: &str) -> String {
+    edited(
+        "[materials.white]\ntype = \"diffuse\"\ncolor = [0.7, 0.7, 0.7]\n",
+        &format!("[materials.white]\ntype = \"pbr\"\nbase_color = [1.0, 1.0, 1.0]\n{fields}\n"),
+    )
+}
+
+#[test]
+fn subsurface_materials_with_bad_fields_are_named() {
+    assert!(parse(&with_subsurface(
+        "subsurface_color = [0.8, 0.5, 0.4]\nsubsurface_radius = 0.2"
+    ))
+    .is_ok());
+    for (fields, needles) in [
+        (
+            "subsurface_color = [0.8, 1.5, 0.4]\nsubsurface_radius = 0.2",
+            &["materials.white.subsurface_color", "[0, 1]"][..],
+        ),
+        (
+            "subsurface_color = [0.8, 0.5, 0.4]",
+            &["materials.white.subsurface_radius", "missing"],
+        ),
+        (
+            "subsurface_radius = [0.1, 0.2, 0.3]",
+            &["materials.white.subsurface_color", "missing"],
+        ),
+        (
+            "subsurface_color = [0.8, 0.5, 0.4]\nsubsurface_radius = -1.0",
+            &["materials.white.subsurface_radius", "must be in"],
+        ),
+        (
+            "subsurface_color = [0.8, 0.5, 0.4]\nsubsurface_radius = 0.2\ntransmission = 0.5",
+            &["materials.white.transmission", "transmits fully"],
+        ),
+    ] {
+        assert_error(&with_subsurface(fields), None, needles);
+    }
+    // Not for other types.
+    let text = edited(
+        "color = [0.7, 0.7, 0.7]\n",
+        "color = [0.7, 0.7, 0.7]\nsubsurface_color = [0.8, 0.5, 0.4]\n",
+    );
+    assert_error(&text, None, &["materials.white.subsurface_color"]);
+    // A quad bounds no volume.
+    let text = with_subsurface("subsurface_color = [0.8, 0.5, 0.4]\nsubsurface_radius = 0.2")
+        .replace("material = \"lamp\"", "material = \"white\"");
+    assert_error(&text, None, &["quads[0].material", "bounds no volume"]);
+}

@@ -48,8 +48,15 @@ fn segment_clear(a: BdptVertex, b: BdptVertex, id: SampleId, s: u32, t: u32) -> 
     if distance <= 0.0 {
         return false;
     }
-    return unoccluded_before(Ray(start, to_end / distance), distance);
+    // Short of the far end by a sliver, as pbrt's SpawnRayTo: where a surface's point is exact
+    // along its normal (an axis-aligned quad), its error bound and so its offset are 0, and
+    // whether the ray meets that surface just before or just after `distance` is down to
+    // rounding.
+    return unoccluded_before(Ray(start, to_end / distance), distance * (1.0 - SHADOW_EPSILON));
 }
+
+// The fraction of a join's length left unsearched at its far end (pbrt's ShadowEpsilon).
+const SHADOW_EPSILON: f32 = 1e-4;
 
 // A vertex's point moved off its surface towards dir (points without a surface as they are).
 fn off_surface(v: BdptVertex, dir: vec3<f32>) -> vec3<f32> {

@@ -74,8 +74,11 @@ pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) ->
 }
 
 /// Traces one segment of the path (and its shadow ray); true when the path has ended.
-/// `segments` counts the ray segments traced, as the kernel's counter does.
-pub fn path_step(
+/// `segments` counts the ray segments traced, as the kernel's counter does. `MEDIA` is the
+/// kernel's HAS_MEDIA, true only for scenes with media (`params.medium_count > 0`): compiled
+/// out like the kernel's, media's branches cost media-free scenes nothing (without it, they
+/// changed how the compiler inlined this function's steps, and cost the Cornell box ~2%).
+pub fn path_step<const MEDIA: bool>(
     scene: &SceneRefs,
     path: &mut PathState,
     pixel: u32,
@@ -98,7 +101,7 @@ pub fn path_step(
     let mut hit = intersect_scene(&scene.geometry, &ray);
     *segments += 1;
     // The kernel compiles media in only for scenes that have them (HAS_MEDIA).
-    if params.medium_count > 0 {
+    if MEDIA {
         let flight = free_flight(scene, path, hit.t, pixel, sample);
         if flight.scattered {
             let position = ray.origin + flight.t * ray.dir;
@@ -147,7 +150,7 @@ pub fn path_step(
     if bounce >= params.max_bounces {
         return true;
     }
-    if params.medium_count > 0 && is_interface(m) {
+    if MEDIA && is_interface(m) {
         return cross_interface(scene, path, &hit);
     }
     let vertex = Vertex {
@@ -157,9 +160,9 @@ pub fn path_step(
         origin: offset_ray_origin(hit.position, hit.error, hit.normal),
     };
     if light_sampling && !is_delta(m) {
-        add_light_sample(scene, path, &vertex, pixel, sample, segments);
+        add_light_sample::<MEDIA>(scene, path, &vertex, pixel, sample, segments);
     }
-    scatter(params, path, &vertex, pixel, sample)
+    scatter::<MEDIA>(params, path, &vertex, pixel, sample)
 }
 
 /// A scattering vertex: the material there, the hit with its mapped shading normal, the coat's
@@ -273,7 +276,7 @@ fn add_hit_emission(
 
 /// Next-event estimation: light arriving after one more scattering event, through a shadow
 /// ray, weighted against BSDF sampling.
-fn add_light_sample(
+fn add_light_sample<const MEDIA: bool>(
     scene: &SceneRefs,
     path: &mut PathState,
     vertex: &Vertex,
@@ -287,12 +290,12 @@ fn add_light_sample(
     let mut light_rng = Rng::with_sampler(pixel, sample, stream, params.seed, params.sampler);
     let light = sample_light(scene, hit.position, vertex.origin, &mut light_rng);
     if light.pdf > 0.0 && !crosses_shading_side(light.dir, hit) {
-        add_unblocked_light(scene, path, vertex, &light, pixel, sample, segments);
+        add_unblocked_light::<MEDIA>(scene, path, vertex, &light, pixel, sample, segments);
     }
 }
 
 /// The sampled light's contribution if the BSDF passes it and nothing blocks the shadow ray.
-fn add_unblocked_light(
+fn add_unblocked_light<const MEDIA: bool>(
     scene: &SceneRefs,
     path: &mut PathState,
     vertex: &Vertex,
@@ -340,37 +343,36 @@ fn add_unblocked_light(
         scene
     };
     // Through participating media the light arrives attenuated, through interfaces too (the
-    // kernel's HAS_MEDIA); else it is seen or not.
-    let through = if params.medium_count > 0 {
+    // kernel's HAS_MEDIA); else it is seen or not, and `through` stays 1.
+    let mut through = Vec3::ONE;
+    if MEDIA {
         let mut media = path.media;
         if light.dir.dot(hit.normal) < 0.0 {
             media = medium_crossed(params, &media, hit.material, hit.front_face);
         }
-        shadow_transmittance(shadow_scene, &shadow, light, &media, segments)
-    } else if light_visible(shadow_scene, &shadow, light) {
-        Vec3::ONE
-    } else {
-        Vec3::ZERO
-    };
-    if through.cmpgt(Vec3::ZERO).any() {
-        let pdf = bsdf_pdf(
-            m,
-            wo,
-            light.dir,
-            hit.shading_normal,
-            vertex.coat_normal,
-            hit.front_face,
-        );
-        let weight = nee_weight(light, pdf);
-        let contribution =
-            path.throughput * f_cos * light.radiance * (weight / light.pdf) * through;
-        path.radiance += firefly_clamp(params, contribution, bounce + 1);
+        through = shadow_transmittance(shadow_scene, &shadow, light, &media, segments);
+        if !through.cmpgt(Vec3::ZERO).any() {
+            return;
+        }
+    } else if !light_visible(shadow_scene, &shadow, light) {
+        return;
     }
+    let pdf = bsdf_pdf(
+        m,
+        wo,
+        light.dir,
+        hit.shading_normal,
+        vertex.coat_normal,
+        hit.front_face,
+    );
+    let weight = nee_weight(light, pdf);
+    let contribution = path.throughput * f_cos * light.radiance * (weight / light.pdf) * through;
+    path.radiance += firefly_clamp(params, contribution, bounce + 1);
 }
 
 /// Samples the BSDF for the path's next ray, with Russian roulette from
 /// `params.roulette_start`; true when the path ends here.
-fn scatter(
+fn scatter<const MEDIA: bool>(
     params: &Params,
     path: &mut PathState,
     vertex: &Vertex,
@@ -399,6 +401,11 @@ fn scatter(
     let mut throughput = path.throughput * s.weight;
     if throughput == Vec3::ZERO || crosses_shading_side(s.dir, hit) {
         return true;
+    }
+    // A direction through the surface enters or leaves the medium it bounds (HAS_MEDIA; the
+    // kernel does this before the roulette, where its branch costs media-free scenes nothing).
+    if MEDIA && s.dir.dot(hit.normal) < 0.0 {
+        path.media = medium_crossed(params, &path.media, hit.material, hit.front_face);
     }
     if bounce >= params.roulette_start {
         // Russian roulette: continue with probability q and divide by it, so the estimate
@@ -431,10 +438,6 @@ fn scatter(
     };
     path.ray_start = p;
     path.bounce = bounce + 1;
-    // A direction through the surface enters or leaves the medium it bounds (HAS_MEDIA).
-    if params.medium_count > 0 && s.dir.dot(hit.normal) < 0.0 {
-        path.media = medium_crossed(params, &path.media, hit.material, hit.front_face);
-    }
     false
 }
 
@@ -448,6 +451,10 @@ pub fn trace_path(
     segments: &mut u32,
 ) -> PathState {
     let mut path = start_path(scene.params, pixel, px, py, sample);
-    while !path_step(scene, &mut path, pixel, sample, segments) {}
+    if scene.params.medium_count > 0 {
+        while !path_step::<true>(scene, &mut path, pixel, sample, segments) {}
+    } else {
+        while !path_step::<false>(scene, &mut path, pixel, sample, segments) {}
+    }
     path
 }

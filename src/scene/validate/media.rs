@@ -1,10 +1,12 @@
 //! `[media.NAME]`: homogeneous media, their coefficients checked, and references to them by
 //! name (`medium = "NAME"` on `[render]`, `[camera]`, spheres and meshes).
 
-use super::super::file::{MediumToml, Real, Triple, S};
+use super::super::file::{MaterialToml, MediumToml, Real, Triple, S};
 use super::super::limits::{MAX_COORDINATE, MIN_LENGTH};
 use super::super::medium::{Medium, MAX_COEFFICIENT};
+use super::super::MaterialKind;
 use super::fields::{fail, real, vec3, FieldError};
+use super::materials::Materials;
 use glam::Vec3;
 use std::collections::BTreeMap;
 
@@ -189,4 +191,87 @@ fn mean_free_path(x: &S<toml::Value>, field: &str) -> Result<Vec3, FieldError> {
         );
     }
     Ok(v)
+}
+
+/// The media `subsurface_color` and `subsurface_radius` make (random-walk subsurface
+/// scattering, as Cycles' `random_walk`): for each pbr material that has them, a medium added
+/// to `media` and the material made fully transmissive (a dielectric boundary over the
+/// medium). Returns, per such material's index, its medium's index.
+///
+/// The colour is the albedo after many scatterings, as artists pick it; the medium's
+/// single-scattering albedo α and extinction σt come from it and the radius d by Chiang, Kutz
+/// and Burley's fit ("Practical and Controllable Subsurface Scattering for Production Path
+/// Tracing", 2016, which Cycles uses): α = 1 − exp(A (−5.09406 + A (2.61188 − 4.31805 A))),
+/// σt = 1 / (d (1.9 − A + 3.5 (A − 0.8)²)), per channel; isotropic (g = 0).
+pub(super) fn subsurface_media(
+    toml: &BTreeMap<String, S<MaterialToml>>,
+    materials: &mut Materials,
+    media: &mut MediaNames,
+) -> Result<BTreeMap<u32, u32>, FieldError> {
+    let mut filled = BTreeMap::new();
+    for (name, m) in toml {
+        let m = m.get_ref();
+        if m.subsurface_color.is_none() && m.subsurface_radius.is_none() {
+            continue;
+        }
+        let field = |f: &str| format!("materials.{name}.{f}");
+        let (Some(color), Some(radius)) = (&m.subsurface_color, &m.subsurface_radius) else {
+            let (given, missing, span) = match (&m.subsurface_color, &m.subsurface_radius) {
+                (Some(c), _) => ("subsurface_color", "subsurface_radius", c.span()),
+                (_, Some(r)) => ("subsurface_radius", "subsurface_color", r.span()),
+                _ => unreachable!("one of them is given"),
+            };
+            return Err(FieldError {
+                span: Some(span),
+                field: field(missing),
+                message: format!("missing: {given} needs {missing} as well"),
+            });
+        };
+        let albedo = vec3(color, &field("subsurface_color"))?;
+        if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
+            return fail(
+                color.span(),
+                field("subsurface_color"),
+                format!("must be in [0, 1] per channel, got {albedo}"),
+            );
+        }
+        let radius = mean_free_path(radius, &field("subsurface_radius"))?;
+        if let Some(t) = &m.transmission {
+            if t.get_ref().0 != 1.0 {
+                return fail(
+                    t.span(),
+                    field("transmission"),
+                    "a subsurface material transmits fully (its surface is a dielectric over \
+                     the medium): leave transmission out, or set it to 1",
+                );
+            }
+        }
+        let fit = |a: f32, d: f32| {
+            let single = 1.0 - (a * (-5.09406 + a * (2.61188 - a * 4.31805))).exp();
+            let extinction = 1.0 / (d * (1.9 - a + 3.5 * (a - 0.8) * (a - 0.8)));
+            (single, extinction.min(MAX_COEFFICIENT))
+        };
+        let mut sigma_a = Vec3::ZERO;
+        let mut sigma_s = Vec3::ZERO;
+        for c in 0..3 {
+            let (single, extinction) = fit(albedo[c], radius[c]);
+            sigma_s[c] = single * extinction;
+            sigma_a[c] = (1.0 - single) * extinction;
+        }
+        let material = materials
+            .index(name)
+            .expect("every [materials] table was validated");
+        if let MaterialKind::Pbr { transmission, .. } = &mut materials.list[material as usize].kind
+        {
+            *transmission = 1.0;
+        }
+        media.list.push(Medium {
+            name: format!("{name} (subsurface)"),
+            sigma_a,
+            sigma_s,
+            g: 0.0,
+        });
+        filled.insert(material, media.list.len() as u32 - 1);
+    }
+    Ok(filled)
 }

@@ -57,7 +57,8 @@ impl SceneToml {
 
         let settings = validate_render(&render, render_span)?;
         let mut materials = materials::validate_materials(&self.materials, folder)?;
-        let media = media::validate_media(&self.media)?;
+        let mut media = media::validate_media(&self.media)?;
+        let subsurface = media::subsurface_media(&self.materials, &mut materials, &mut media)?;
         let global = render
             .medium
             .as_ref()
@@ -75,6 +76,7 @@ impl SceneToml {
             folder,
             &mut materials,
             &media,
+            &subsurface,
         )?;
         if objects.boundaries.len() + 2 > MAX_MEDIUM_SLOTS {
             return Err(whole(

@@ -79,6 +79,7 @@ pub(super) fn validate_objects(
     folder: &Path,
     materials: &mut Materials,
     media: &MediaNames,
+    subsurface: &BTreeMap<u32, u32>,
 ) -> Result<Objects, FieldError> {
     let mut boundaries = Boundaries {
         media,
@@ -87,8 +88,12 @@ pub(super) fn validate_objects(
     let mut spheres = Vec::with_capacity(spheres_toml.len());
     for (i, s) in spheres_toml.iter().enumerate() {
         let mut sphere = validate_sphere(s.get_ref(), i, materials)?;
-        if let Some(m) = &s.get_ref().medium {
-            let medium = media.reference(m, &format!("spheres[{i}].medium"))?;
+        // An explicit medium, else the one a subsurface material implies.
+        let medium = match &s.get_ref().medium {
+            Some(m) => Some(media.reference(m, &format!("spheres[{i}].medium"))?),
+            None => subsurface.get(&sphere.material).copied(),
+        };
+        if let Some(medium) = medium {
             sphere.material = boundaries.material(sphere.material, medium, materials);
         }
         spheres.push(sphere);
@@ -98,6 +103,16 @@ pub(super) fn validate_objects(
         .enumerate()
         .map(|(i, q)| validate_quad(q.get_ref(), i, materials))
         .collect::<Result<Vec<_>, _>>()?;
+    for (i, (q, quad)) in quads_toml.iter().zip(&quads).enumerate() {
+        if subsurface.contains_key(&quad.material) {
+            return fail(
+                q.get_ref().material.span(),
+                format!("quads[{i}].material"),
+                "a subsurface material fills its object with a medium, and a quad bounds no \
+                 volume: use it on spheres and closed meshes",
+            );
+        }
+    }
     let mut meshes = Meshes {
         triangles: Vec::new(),
         instanced: Vec::new(),
@@ -107,16 +122,25 @@ pub(super) fn validate_objects(
         warnings: opaque_only_warnings(&spheres, &quads, &materials.list),
     };
     for (i, m) in meshes_toml.iter().enumerate() {
-        let medium = match &m.get_ref().medium {
-            Some(name) => Some((media.reference(name, &format!("meshes[{i}].medium"))?, name)),
-            None => None,
+        let medium = match (&m.get_ref().medium, &m.get_ref().material) {
+            (Some(name), _) => Some((
+                media.reference(name, &format!("meshes[{i}].medium"))?,
+                name,
+                "medium",
+            )),
+            // A subsurface material given to the whole mesh fills it.
+            (None, Some(material)) => materials
+                .index(material.get_ref())
+                .and_then(|index| subsurface.get(&index))
+                .map(|&medium| (medium, material, "material")),
+            (None, None) => None,
         };
         let (triangles, instanced) = (meshes.triangles.len(), meshes.instanced.len());
         meshes.add(m.get_ref(), i, folder, materials)?;
-        if let Some((medium, name)) = medium {
+        if let Some((medium, name, key)) = medium {
             meshes
                 .fill(triangles, instanced, medium, materials, &mut boundaries)
-                .or_else(|message| fail(name.span(), format!("meshes[{i}].medium"), message))?;
+                .or_else(|message| fail(name.span(), format!("meshes[{i}].{key}"), message))?;
         }
     }
     Ok(Objects {

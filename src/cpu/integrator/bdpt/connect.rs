@@ -51,7 +51,7 @@ const NOTHING: Connection = Connection {
 
 /// Whether nothing blocks the segment between two vertices (one may be at infinity): a
 /// shadow ray from just off the first towards just off the second.
-fn segment_clear(
+pub fn segment_clear(
     scene: &SceneRefs,
     a: &BdptVertex,
     b: &BdptVertex,
@@ -76,8 +76,15 @@ fn segment_clear(
         origin: start,
         dir: to_end / distance,
     };
-    unoccluded_before(geometry, &ray, distance)
+    // Short of the far end by a sliver, as pbrt's `SpawnRayTo`: where a surface's point is
+    // exact along its normal (an axis-aligned quad), its error bound and so its offset are 0,
+    // and whether the ray meets that surface just before or just after `distance` is down to
+    // rounding (measured: 4.5% of the joins from a wall to the floor were lost so).
+    unoccluded_before(geometry, &ray, distance * (1.0 - SHADOW_EPSILON))
 }
+
+/// The fraction of a join's length left unsearched at its far end (pbrt's `ShadowEpsilon`).
+pub const SHADOW_EPSILON: f32 = 1e-4;
 
 /// A vertex's point moved off its surface towards `dir` (points without a surface as they
 /// are).

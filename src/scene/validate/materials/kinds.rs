@@ -173,6 +173,16 @@ pub(super) fn check_fields_apply(
             "sheen_roughness",
             pbr,
         ),
+        (
+            m.subsurface_color.as_ref().map(|r| r.span()),
+            "subsurface_color",
+            pbr,
+        ),
+        (
+            m.subsurface_radius.as_ref().map(|r| r.span()),
+            "subsurface_radius",
+            pbr,
+        ),
     ] {
         if let (Some(span), false) = (span, applies) {
             return fail(

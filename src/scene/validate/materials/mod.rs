@@ -27,6 +27,11 @@ pub(super) struct Materials {
 }
 
 impl Materials {
+    /// The index of the material called `name`.
+    pub(super) fn index(&self, name: &str) -> Option<u32> {
+        self.index_of.get(name).copied()
+    }
+
     /// The index of the material `m` names; an unknown name fails at `field`.
     pub(super) fn reference(&self, m: &S<String>, field: String) -> Result<u32, FieldError> {
         self.index_of.get(m.get_ref()).copied().ok_or_else(|| {
