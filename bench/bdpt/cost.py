@@ -9,11 +9,10 @@ error (MSE ∝ 1 / time for an unbiased estimator), and bdpt's over path's is th
 
     GLINT=target/release/glint GLINT_ASSETS=../shared/assets python3 bench/bdpt/cost.py OUT_DIR
 """
-import os, re, resource, subprocess, sys, tempfile
+import os, sys
 import numpy as np
-import OpenEXR, Imath
+from common import load, render, rel_mse
 
-GLINT = os.environ.get("GLINT", "target/release/glint")
 OUT = sys.argv[1] if len(sys.argv) > 1 else "bdpt-cost"
 os.makedirs(OUT, exist_ok=True)
 SEEDS = [1, 2, 3]
@@ -40,43 +39,18 @@ if helmet_scene():
     CASES.append(("helmet", os.path.join(OUT, "helmet.toml"), 64, 2048, 32, 8))
 
 
-def load(path):
-    f = OpenEXR.InputFile(path)
-    dw = f.header()["dataWindow"]
-    w, h = dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1
-    pt = Imath.PixelType(Imath.PixelType.FLOAT)
-    return np.stack([np.frombuffer(f.channel(c, pt), np.float32).reshape(h, w) for c in "RGB"], -1)
-
-
-def render(scene, size, spp, integrator, seed, out):
-    if os.path.exists(out + ".seconds"):
-        return float(open(out + ".seconds").read())
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([GLINT, "render", scene, "--cpu", "--width", str(size), "--height", str(size),
-                    "--spp", str(spp), "--seed", str(seed), "--integrator", integrator,
-                    "-o", out], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    seconds = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-    open(out + ".seconds", "w").write(str(seconds))
-    return seconds
-
-
-def rel_mse(img, ref):
-    return float(np.mean((img - ref) ** 2 / (ref ** 2 + 1e-2)))
-
-
 print("| scene, size | CPU s per render (bdpt / path) | rel. MSE (bdpt / path) | time to equal error, bdpt / path |")
 print("|---|---|---|---|")
 for name, scene, size, ref_spp, path_spp, bdpt_spp in CASES:
     ref_out = os.path.join(OUT, f"{name}-ref.exr")
-    render(scene, size, ref_spp, "path", 999, ref_out)
+    render(scene, size, size, ref_spp, "path", 999, ref_out)
     ref = load(ref_out)
     rows = {}
     for integrator, spp in (("path", path_spp), ("bdpt", bdpt_spp)):
         errors, seconds = [], []
         for seed in SEEDS:
             out = os.path.join(OUT, f"{name}-{integrator}-{seed}.exr")
-            seconds.append(render(scene, size, spp, integrator, seed, out))
+            seconds.append(render(scene, size, size, spp, integrator, seed, out))
             errors.append(rel_mse(load(out), ref))
         rows[integrator] = (float(np.median(errors)), float(np.median(seconds)))
     (eb, tb), (ep, tp) = rows["bdpt"], rows["path"]
