@@ -193,6 +193,11 @@ def convert_material(name, m):
                 "k": rgb([f[1] for f in fits])}
         if roughness > 0:
             bsdf.update(type="roughconductor", distribution="ggx", alpha=roughness * roughness)
+    elif kind == "interface":
+        # A boundary that only separates media: light passes it unchanged (Mitsuba's null
+        # BSDF, which volpath crosses without counting a scattering event).
+        check_keys(m, ["type"], where)
+        return {"type": "null"}, None
     elif kind == "dielectric":
         check_keys(m, common + ["ior", "color"], where)
         bsdf = {"type": "dielectric", "int_ior": number(m["ior"], f"{where}.ior"),
@@ -214,6 +219,66 @@ def convert_material(name, m):
     return bsdf, emitted
 
 
+def convert_medium(name, m):
+    """Mitsuba's `homogeneous` medium (a dict) for glint's `[media.NAME]`: σt = σa + σs and
+    the albedo σs / σt per channel, and a Henyey–Greenstein phase function with glint's g
+    (both take g > 0 as forwards). σt is given as a colour in [0, 1] times `scale`, so that
+    Mitsuba's RGB colour stays in the range it accepts."""
+    where = f"media.{name}"
+    if not isinstance(m, dict):
+        raise ConversionError(f"{where}: expected a table")
+    check_keys(m, ["sigma_a", "sigma_s", "color", "density", "mean_free_path", "g"], where)
+    physical = "sigma_a" in m or "sigma_s" in m
+    artist = [k for k in ["color", "density", "mean_free_path"] if k in m]
+    if physical and artist:
+        raise ConversionError(f"{where}.{artist[0]}: give either sigma_a and sigma_s, or color "
+                              "with density or mean_free_path, not both")
+    if physical:
+        sigma_a = vec3(m.get("sigma_a", [0, 0, 0]), f"{where}.sigma_a")
+        sigma_s = vec3(m.get("sigma_s", [0, 0, 0]), f"{where}.sigma_s")
+        if min(sigma_a + sigma_s) < 0:
+            raise ConversionError(f"{where}: coefficients must be >= 0")
+    else:
+        if "color" not in m:
+            raise ConversionError(f"{where}.color: missing: a medium needs sigma_a and "
+                                  "sigma_s, or color with density or mean_free_path")
+        albedo = vec3(m["color"], f"{where}.color")
+        if min(albedo) < 0 or max(albedo) > 1:
+            raise ConversionError(f"{where}.color: must be in [0, 1] per channel")
+        if ("density" in m) == ("mean_free_path" in m):
+            raise ConversionError(f"{where}: give density or mean_free_path (one of them)")
+        if "density" in m:
+            sigma_t = [number(m["density"], f"{where}.density")] * 3
+        else:
+            path = m["mean_free_path"]
+            path = (vec3(path, f"{where}.mean_free_path") if isinstance(path, list)
+                    else [number(path, f"{where}.mean_free_path")] * 3)
+            if min(path) <= 0:
+                raise ConversionError(f"{where}.mean_free_path: must be > 0")
+            sigma_t = [1 / x for x in path]
+        if min(sigma_t) < 0:
+            raise ConversionError(f"{where}.density: must be >= 0")
+        sigma_a = [t * (1 - a) for t, a in zip(sigma_t, albedo)]
+        sigma_s = [t * a for t, a in zip(sigma_t, albedo)]
+    g = number(m.get("g", 0.0), f"{where}.g")
+    if abs(g) >= 1:
+        raise ConversionError(f"{where}.g: must be in (-1, 1), got {g}")
+    sigma_t = add(sigma_a, sigma_s)
+    scale = max(sigma_t)
+    return {
+        "type": "homogeneous",
+        "sigma_t": rgb([t / scale for t in sigma_t] if scale > 0 else [0.0] * 3),
+        "scale": scale if scale > 0 else 1.0,
+        "albedo": rgb([s / t if t > 0 else 0.0 for s, t in zip(sigma_s, sigma_t)]),
+        "phase": {"type": "hg", "g": g},
+    }
+
+
+def boxes_overlap(a, b):
+    """Whether two axis-aligned boxes (min, max) share a volume (touching is not enough)."""
+    return all(a[0][i] < b[1][i] and b[0][i] < a[1][i] for i in range(3))
+
+
 def convert_scene(scene_path, overrides):
     """The Mitsuba scene dict and a summary of the settings used."""
     import mitsuba as mi
@@ -223,12 +288,13 @@ def convert_scene(scene_path, overrides):
             scene = tomllib.load(f)
         except tomllib.TOMLDecodeError as e:
             raise ConversionError(f"{scene_path}: {e}") from e
-    check_keys(scene, ["camera", "render", "materials", "spheres", "quads", "meshes"], "scene")
+    check_keys(scene, ["camera", "render", "materials", "spheres", "quads", "meshes", "media"],
+               "scene")
     folder = os.path.dirname(os.path.abspath(scene_path))
 
     render = dict(scene.get("render", {}))
     check_keys(render, ["width", "height", "spp", "max_bounces", "background", "seed",
-                        "light_sampling", "russian_roulette"], "render")
+                        "light_sampling", "russian_roulette", "medium"], "render")
     for key in ["width", "height", "spp", "max_bounces", "seed"]:
         if overrides.get(key) is not None:
             render[key] = overrides[key]
@@ -244,7 +310,8 @@ def convert_scene(scene_path, overrides):
     background = vec3(render.get("background", [0, 0, 0]), "render.background")
 
     cam = scene["camera"]
-    check_keys(cam, ["eye", "target", "up", "vfov", "aperture", "focus_distance"], "camera")
+    check_keys(cam, ["eye", "target", "up", "vfov", "aperture", "focus_distance", "medium"],
+               "camera")
     eye, target, up = (vec3(cam[k], f"camera.{k}") for k in ["eye", "target", "up"])
     to_world = mi.ScalarTransform4f().look_at(origin=eye, target=target, up=up)
     aperture = number(cam.get("aperture", 0.0), "camera.aperture")
@@ -271,9 +338,32 @@ def convert_scene(scene_path, overrides):
     else:
         sensor["type"] = "perspective"
 
+    # Media: Mitsuba's homogeneous media, one object per glint medium, which every shape
+    # bounding it (and the sensor inside it) shares.
+    media_toml = scene.get("media", {})
+    if not isinstance(media_toml, dict):
+        raise ConversionError("media: expected tables [media.NAME]")
+    media = {name: mi.load_dict(convert_medium(name, m)) for name, m in media_toml.items()}
+
+    def medium_named(name, where):
+        if name is None:
+            return None
+        if name not in media:
+            raise ConversionError(f"{where}: unknown medium {name!r}")
+        return media[name]
+
+    global_medium = medium_named(render.get("medium"), "render.medium")
+    camera_medium = medium_named(cam.get("medium", render.get("medium")), "camera.medium")
+    if camera_medium is not None:
+        sensor["medium"] = camera_medium
+    integrator = overrides.get("integrator") or ("volpath" if media else "path")
+    if media and integrator == "path":
+        raise ConversionError("media: Mitsuba's path integrator ignores media; use volpath "
+                              "or volpathmis")
+
     out = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": max_depth, "rr_depth": rr_depth},
+        "integrator": {"type": integrator, "max_depth": max_depth, "rr_depth": rr_depth},
         "sensor": sensor,
     }
     if max(background) > 0:
@@ -282,6 +372,11 @@ def convert_scene(scene_path, overrides):
     materials = {}
     for name, m in scene.get("materials", {}).items():
         materials[name] = convert_material(name, m)
+        if (media and m.get("type") == "dielectric" and m.get("ior") == 1
+                and m.get("color", [1, 1, 1]) == [1, 1, 1] and "emission" not in m):
+            # In a scene with media glint crosses an index-matched, untinted dielectric as an
+            # interface (no scattering event), as Mitsuba's volpath crosses a null BSDF.
+            materials[name] = ({"type": "null"}, None)
 
     def material_of(shape, where):
         name = shape.get("material")
@@ -292,9 +387,27 @@ def convert_scene(scene_path, overrides):
             raise ConversionError(f"{where}.material: unknown material {name!r}")
         return materials[name]
 
+    # Which medium each side of a shape is in. Mitsuba takes it from the shape (its interior and
+    # exterior), glint from the boundaries the path has crossed (a stack): they agree where each
+    # object with a medium sits in the global medium, apart from every other shape. Shapes
+    # that bound no medium have the global medium on both sides (glint: "a glass ball in fog
+    # is full of fog").
+    boxes = []  # (where, bounding box, whether the shape bounds a medium)
+
+    def set_media(shape, inside, where, box):
+        if inside is not None:
+            shape["interior"] = inside
+            if global_medium is not None:
+                shape["exterior"] = global_medium
+        elif global_medium is not None:
+            shape["interior"] = shape["exterior"] = global_medium
+        if media:
+            boxes.append((where, box, inside is not None))
+        return shape
+
     def attach(shape, material, power_per_radiance):
         """Adds the BSDF and, for emitters, an area emitter whose selection weight is glint's
-        (mean emitted radiance × area)."""
+        (mean emitted radiance × area); the shape's media stay as set_media set them."""
         bsdf, emitted = material
         shape["bsdf"] = bsdf
         if emitted is not None:
@@ -307,39 +420,51 @@ def convert_scene(scene_path, overrides):
     counts = {"spheres": 0, "quads": 0, "meshes": 0}
     for i, s in enumerate(scene.get("spheres", [])):
         where = f"spheres[{i}]"
-        check_keys(s, ["center", "radius", "material"], where)
+        check_keys(s, ["center", "radius", "material", "medium"], where)
         radius = number(s["radius"], f"{where}.radius")
         center = vec3(s["center"], f"{where}.center")
         material = material_of(s, where)
-        out[f"sphere_{i}"] = attach({"type": "sphere", "center": center, "radius": radius},
-                                    material, 4 * math.pi * radius * radius)
+        inside = medium_named(s.get("medium"), f"{where}.medium")
+        box = (sub(center, [radius] * 3), add(center, [radius] * 3))
+        shape = set_media({"type": "sphere", "center": center, "radius": radius}, inside,
+                          where, box)
+        out[f"sphere_{i}"] = attach(dict(shape), material, 4 * math.pi * radius * radius)
         if material[1] is not None:
             # glint's emitters emit from both sides, Mitsuba's area lights from the front
             # only: a slightly smaller twin facing inwards emits into the sphere.
-            out[f"sphere_{i}_inside"] = attach(
-                {"type": "sphere", "center": center, "radius": radius * (1 - TWIN_OFFSET),
-                 "flip_normals": True}, material, 4 * math.pi * radius * radius)
+            twin = dict(shape, radius=radius * (1 - TWIN_OFFSET), flip_normals=True)
+            if inside is not None:  # flipped: its outside faces the sphere's inside
+                twin["interior"], twin["exterior"] = shape.get("exterior"), inside
+                twin = {k: v for k, v in twin.items() if v is not None}
+            out[f"sphere_{i}_inside"] = attach(twin, material, 4 * math.pi * radius * radius)
         counts["spheres"] += 1
     for i, q in enumerate(scene.get("quads", [])):
         where = f"quads[{i}]"
-        check_keys(q, ["corner", "u", "v", "material"], where)
-        matrix, area = quad_to_world(vec3(q["corner"], f"{where}.corner"),
-                                     vec3(q["u"], f"{where}.u"), vec3(q["v"], f"{where}.v"), where)
+        check_keys(q, ["corner", "u", "v", "material", "medium"], where)
+        if "medium" in q:
+            raise ConversionError(f"{where}.medium: a quad bounds no volume (glint refuses it "
+                                  "too)")
+        corner, u, v = (vec3(q[k], f"{where}.{k}") for k in ["corner", "u", "v"])
+        matrix, area = quad_to_world(corner, u, v, where)
         material = material_of(q, where)
         to_world = mi.ScalarTransform4f(matrix)
-        out[f"quad_{i}"] = attach({"type": "rectangle", "to_world": to_world}, material, area)
+        corners = [corner, add(corner, u), add(corner, v), add(add(corner, u), v)]
+        box = ([min(c[k] for c in corners) for k in range(3)],
+               [max(c[k] for c in corners) for k in range(3)])
+        shape = set_media({"type": "rectangle", "to_world": to_world}, None, where, box)
+        out[f"quad_{i}"] = attach(dict(shape), material, area)
         if material[1] is not None:
             # Back-side emission (see spheres): a twin facing the other way, moved behind
             # the quad by a hair; turning y and z over keeps the frame right-handed.
             behind = -TWIN_OFFSET * math.sqrt(area)
             flip = [[1.0, 0, 0, 0], [0, -1.0, 0, 0], [0, 0, -1.0, behind], [0, 0, 0, 1.0]]
             out[f"quad_{i}_back"] = attach(
-                {"type": "rectangle", "to_world": to_world @ mi.ScalarTransform4f(flip)},
-                material, area)
+                dict(shape, to_world=to_world @ mi.ScalarTransform4f(flip)), material, area)
         counts["quads"] += 1
     for i, mesh in enumerate(scene.get("meshes", [])):
         where = f"meshes[{i}]"
-        check_keys(mesh, ["file", "material", "translate", "rotate", "scale", "smooth"], where)
+        check_keys(mesh, ["file", "material", "translate", "rotate", "scale", "smooth", "medium"],
+                   where)
         file = mesh.get("file")
         if not isinstance(file, str):
             raise ConversionError(f"{where}.file: missing or not a string")
@@ -359,21 +484,39 @@ def convert_scene(scene_path, overrides):
                  # compute smooth ones for a file without them, so ask for face normals then.
                  "face_normals": not (smooth and file_has_normals(path, ext))}
         material = material_of(mesh, where)
-        area = None
-        if material[1] is not None:
+        inside = medium_named(mesh.get("medium"), f"{where}.medium")
+        area, box = None, None
+        if material[1] is not None or media:
             try:
-                area = mi.load_dict(dict(shape)).surface_area()
+                loaded = mi.load_dict(dict(shape))
             except Exception as e:  # Mitsuba's loaders raise plain exceptions
                 raise ConversionError(f"{where}.file: {path}: Mitsuba cannot read it: {e}")
+            area = loaded.surface_area()
             area = float(area[0] if hasattr(area, "__len__") else area)
-        out[f"mesh_{i}"] = attach(shape, material, area)
+            bbox = loaded.bbox()
+            box = ([float(bbox.min[k]) for k in range(3)], [float(bbox.max[k]) for k in range(3)])
+        # Mitsuba does not check that a mesh bounding a medium is closed; glint refuses an
+        # open one, so a scene glint renders has a closed one here.
+        shape = set_media(shape, inside, where, box)
+        out[f"mesh_{i}"] = attach(shape, material, area if material[1] is not None else None)
         if material[1] is not None:
             print(f"compare.py: warning: {where}: Mitsuba's area lights emit on the front "
                   "side only (the triangles' winding); glint's emit on both", file=sys.stderr)
         counts["meshes"] += 1
 
+    for a, (where_a, box_a, bounds_a) in enumerate(boxes):
+        for where_b, box_b, bounds_b in boxes[a + 1:]:
+            if (bounds_a or bounds_b) and boxes_overlap(box_a, box_b):
+                raise ConversionError(
+                    f"{where_a} and {where_b}: an object filled with a medium overlaps or holds "
+                    "another shape (their bounding boxes share a volume); not mapped: Mitsuba "
+                    "takes each shape's inside and outside medium from the shape, glint from "
+                    "the boundaries a path has crossed, and this script maps only objects with "
+                    "a medium set apart in the global one")
+
     summary = {"width": width, "height": height, "spp": spp, "max_bounces": max_bounces,
-               "max_depth": max_depth, "rr_depth": rr_depth,
+               "max_depth": max_depth, "rr_depth": rr_depth, "integrator": integrator,
+               "media": len(media),
                "seed": int(render.get("seed", 0)), **counts}
     return out, summary
 
@@ -388,6 +531,9 @@ def main():
     parser.add_argument("--seed", type=int)
     parser.add_argument("--runs", type=int, default=3, help="timed runs after the warm-up")
     parser.add_argument("--variant", default="llvm_ad_rgb")
+    parser.add_argument("--integrator", choices=["path", "volpath", "volpathmis"],
+                        help="Mitsuba's integrator (default: volpath if the scene has media, "
+                        "else path)")
     parser.add_argument("--threads", type=int, help="Dr.Jit's thread pool size (default: all)")
     parser.add_argument("-o", "--output", help="EXR of the warm-up render (linear float32)")
     parser.add_argument("--png", help="PNG of the warm-up render (clamped, sRGB)")
