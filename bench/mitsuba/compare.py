@@ -219,11 +219,14 @@ def convert_material(name, m):
     return bsdf, emitted
 
 
-def convert_medium(name, m):
+def convert_medium(name, m, channel=None):
     """Mitsuba's `homogeneous` medium (a dict) for glint's `[media.NAME]`: σt = σa + σs and
     the albedo σs / σt per channel, and a Henyey–Greenstein phase function with glint's g
     (both take g > 0 as forwards). σt is given as a colour in [0, 1] times `scale`, so that
-    Mitsuba's RGB colour stays in the range it accepts."""
+    Mitsuba's RGB colour stays in the range it accepts. With `channel` (0, 1, 2), every
+    channel takes that channel's coefficients: a grey medium whose render is, in that channel,
+    the same as the coloured one's (RGB channels do not mix), without the noise of sampling
+    free flights in a medium whose σt differs per channel."""
     where = f"media.{name}"
     if not isinstance(m, dict):
         raise ConversionError(f"{where}: expected a table")
@@ -263,6 +266,8 @@ def convert_medium(name, m):
     g = number(m.get("g", 0.0), f"{where}.g")
     if abs(g) >= 1:
         raise ConversionError(f"{where}.g: must be in (-1, 1), got {g}")
+    if channel is not None:
+        sigma_a, sigma_s = [sigma_a[channel]] * 3, [sigma_s[channel]] * 3
     sigma_t = add(sigma_a, sigma_s)
     scale = max(sigma_t)
     return {
@@ -343,7 +348,10 @@ def convert_scene(scene_path, overrides):
     media_toml = scene.get("media", {})
     if not isinstance(media_toml, dict):
         raise ConversionError("media: expected tables [media.NAME]")
-    media = {name: mi.load_dict(convert_medium(name, m)) for name, m in media_toml.items()}
+    grey = overrides.get("medium_channel")
+    media_dicts = {name: convert_medium(name, m, grey) for name, m in media_toml.items()}
+    spectral = any(len(set(d["sigma_t"]["value"])) > 1 for d in media_dicts.values())
+    media = {name: mi.load_dict(d) for name, d in media_dicts.items()}
 
     def medium_named(name, where):
         if name is None:
@@ -516,7 +524,7 @@ def convert_scene(scene_path, overrides):
 
     summary = {"width": width, "height": height, "spp": spp, "max_bounces": max_bounces,
                "max_depth": max_depth, "rr_depth": rr_depth, "integrator": integrator,
-               "media": len(media),
+               "media": len(media), "spectral_extinction": spectral, "medium_channel": grey,
                "seed": int(render.get("seed", 0)), **counts}
     return out, summary
 
@@ -534,6 +542,10 @@ def main():
     parser.add_argument("--integrator", choices=["path", "volpath", "volpathmis"],
                         help="Mitsuba's integrator (default: volpath if the scene has media, "
                         "else path)")
+    parser.add_argument("--medium-channel", type=int, choices=[0, 1, 2], dest="medium_channel",
+                        help="give every medium the coefficients of this channel (0 red, 1 "
+                        "green, 2 blue) in all three: the image is right in that channel only, "
+                        "and is a low-noise reference for it where σt differs per channel")
     parser.add_argument("--threads", type=int, help="Dr.Jit's thread pool size (default: all)")
     parser.add_argument("-o", "--output", help="EXR of the warm-up render (linear float32)")
     parser.add_argument("--png", help="PNG of the warm-up render (clamped, sRGB)")

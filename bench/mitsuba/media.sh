@@ -1,11 +1,17 @@
 #!/usr/bin/env bash
 # glint's participating media against Mitsuba 3's volpath, per pixel: for each scene in
-# bench/mitsuba/media/ (a fog box, two smoke spheres with g = 0.7 and -0.5, a glass sphere
-# over a chromatic medium), Mitsuba renders RUNS independent images of MSPP spp (compare.py
-# --variance: their mean, and the variance of that mean from their spread), glint's CPU
-# reference renders GSPP spp with its variance image, and `glint compare` runs the per-pixel
-# Z-test on the two. Prints one line per scene (pass rate, z of the means, variance ratio,
-# means) and writes the images and compare's JSON to OUT.
+# bench/mitsuba/media/ (a fog box, two smoke spheres with g = 0.7 and -0.5, glass spheres over
+# a medium of chromatic albedo and over one whose σt differs per channel), Mitsuba renders
+# RUNS independent images of MSPP spp (compare.py --variance: their mean, and the variance of
+# that mean from their spread), glint's CPU reference renders GSPP spp with its variance
+# image, and `glint compare` runs the per-pixel Z-test on the two. Prints per scene the pass
+# rate, the z of the image means, the variance ratio and the means, then the same per channel.
+#
+# Where a medium's σt differs per channel, Mitsuba's volpath samples free flights in one
+# channel per path and weighs the others by their transmittance ratio, whose noise is heavy
+# tailed; there the script also renders Mitsuba once per channel with grey media of that
+# channel's coefficients (compare.py --medium-channel) and tests glint against those channels
+# put together ("per-channel reference").
 #
 #   bench/mitsuba/media.sh [SCENE.toml ...]     (default: every scene in bench/mitsuba/media/)
 #
@@ -37,6 +43,18 @@ size=()
 [[ -n "${WIDTH:-}" ]] && size+=(--width "$WIDTH")
 [[ -n "${HEIGHT:-}" ]] && size+=(--height "$HEIGHT")
 
+# One line from glint compare's JSON: pass rate, z of the means, variance ratio, means.
+summary() {
+    python3 - "$1" "$2" <<'PY'
+import json, sys
+c = json.load(open(sys.argv[1]))
+z = c["z_test"]
+rgb = lambda m: " ".join(f"{x:.4f}" for x in m)
+print(f"{sys.argv[2]:<22} {100 * z['pass_rate']:8.2f}% {z['z_of_means']:8.2f} "
+      f"{z['variance_ratio']:8.3f}  {rgb(c['mean_a']):<26} {rgb(c['mean_b'])}")
+PY
+}
+
 out=${OUT:-$(mktemp -d /tmp/glint-media-vs-mitsuba.XXXXXX)}
 mkdir -p "$out"
 echo "Mitsuba $integrator: $runs renders of $mspp spp; glint CPU reference: $gspp spp; files in $out" >&2
@@ -54,12 +72,35 @@ for scene in "${scenes[@]}"; do
     "$glint" compare "$out/$name-glint.exr" "$out/$name-mitsuba.exr" \
         --variance-a "$out/$name-glint-variance.exr" \
         --variance-b "$out/$name-mitsuba-variance.exr" --json > "$out/$name-compare.json"
-    python3 - "$out/$name-compare.json" "$name" <<'PY'
-import json, sys
-c = json.load(open(sys.argv[1]))
-z = c["z_test"]
-rgb = lambda m: " ".join(f"{x:.4f}" for x in m)
-print(f"{sys.argv[2]:<22} {100 * z['pass_rate']:8.2f}% {z['z_of_means']:8.2f} "
-      f"{z['variance_ratio']:8.3f}  {rgb(c['mean_a']):<26} {rgb(c['mean_b'])}")
-PY
+    summary "$out/$name-compare.json" "$name"
+    python3 "$here/channels.py" test "against volpath" \
+        "$out/$name-glint.exr" "$out/$name-glint-variance.exr" \
+        "$out/$name-mitsuba.exr" "$out/$name-mitsuba-variance.exr"
+    spectral=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["spectral_extinction"])' \
+        "$out/$name-mitsuba.json")
+    if [[ $spectral == True ]]; then
+        for channel in 0 1 2; do
+            python3 "$here/compare.py" "$scene" "${size[@]}" --spp "$mspp" \
+                --runs $((runs - 1)) --seed "$((seed + 1000 * (channel + 1)))" \
+                --integrator "$integrator" --medium-channel "$channel" \
+                -o "$out/$name-mitsuba-c$channel.exr" \
+                --variance "$out/$name-mitsuba-c$channel-variance.exr" \
+                > "$out/$name-mitsuba-c$channel.json"
+        done
+        python3 "$here/channels.py" compose "$out/$name-mitsuba-channels.exr" \
+            "$out/$name"-mitsuba-c{0,1,2}.exr
+        python3 "$here/channels.py" compose "$out/$name-mitsuba-channels-variance.exr" \
+            "$out/$name"-mitsuba-c{0,1,2}-variance.exr
+        "$glint" compare "$out/$name-glint.exr" "$out/$name-mitsuba-channels.exr" \
+            --variance-a "$out/$name-glint-variance.exr" \
+            --variance-b "$out/$name-mitsuba-channels-variance.exr" --json \
+            > "$out/$name-channels-compare.json"
+        summary "$out/$name-channels-compare.json" "  per-channel ref."
+        python3 "$here/channels.py" test "per-channel ref." \
+            "$out/$name-glint.exr" "$out/$name-glint-variance.exr" \
+            "$out/$name-mitsuba-channels.exr" "$out/$name-mitsuba-channels-variance.exr"
+        python3 "$here/channels.py" test "volpath vs that ref." \
+            "$out/$name-mitsuba.exr" "$out/$name-mitsuba-variance.exr" \
+            "$out/$name-mitsuba-channels.exr" "$out/$name-mitsuba-channels-variance.exr"
+    fi
 done
