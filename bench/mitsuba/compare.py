@@ -364,6 +364,9 @@ def convert_scene(scene_path, overrides):
     camera_medium = medium_named(cam.get("medium", render.get("medium")), "camera.medium")
     if camera_medium is not None:
         sensor["medium"] = camera_medium
+        # Mitsuba's camera rays start at the near clip plane: in a medium, the fog in front of
+        # it would be missing (1e-3 of a unit-sized scene is 0.1% of its depth).
+        sensor["near_clip"] = 1e-6 * length(sub(target, eye))
     integrator = overrides.get("integrator") or ("volpath" if media else "path")
     if media and integrator == "path":
         raise ConversionError("media: Mitsuba's path integrator ignores media; use volpath "
