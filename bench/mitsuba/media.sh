@@ -18,7 +18,8 @@
 # Environment: RUNS (16), MSPP (256), GSPP (4096), WIDTH/HEIGHT (the scenes' 32x32), SEED
 # (1: Mitsuba uses seeds SEED.. SEED+RUNS-1, glint SEED), OUT (a new folder under /tmp),
 # GLINT (target/release/glint), INTEGRATOR (Mitsuba's: volpath, or volpathmis),
-# DRJIT_LIBLLVM_PATH (see README.md).
+# DRJIT_LIBLLVM_PATH (see README.md), REUSE (1: keep Mitsuba's images already in OUT, to
+# test another glint build against the same references).
 set -euo pipefail
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -55,6 +56,11 @@ print(f"{sys.argv[2]:<22} {100 * z['pass_rate']:8.2f}% {z['z_of_means']:8.2f} "
 PY
 }
 
+# Whether REUSE=1 and Mitsuba's image, variance and JSON named $1 are in OUT already.
+reused() {
+    [[ "${REUSE:-0}" == 1 && -s "$out/$1.exr" && -s "$out/$1-variance.exr" && -s "$out/$1.json" ]]
+}
+
 out=${OUT:-$(mktemp -d /tmp/glint-media-vs-mitsuba.XXXXXX)}
 mkdir -p "$out"
 echo "Mitsuba $integrator: $runs renders of $mspp spp; glint CPU reference: $gspp spp; files in $out" >&2
@@ -62,10 +68,12 @@ printf '%-22s %9s %8s %8s  %-26s %s\n' scene pass z_means var_ratio "glint mean 
 for scene in "${scenes[@]}"; do
     name=$(basename "$scene" .toml)
     # compare.py renders once plus --runs more, each with its own seed.
-    python3 "$here/compare.py" "$scene" "${size[@]}" --spp "$mspp" --runs $((runs - 1)) \
-        --seed "$seed" --integrator "$integrator" \
-        -o "$out/$name-mitsuba.exr" --variance "$out/$name-mitsuba-variance.exr" \
-        > "$out/$name-mitsuba.json"
+    if ! reused "$name-mitsuba"; then
+        python3 "$here/compare.py" "$scene" "${size[@]}" --spp "$mspp" --runs $((runs - 1)) \
+            --seed "$seed" --integrator "$integrator" \
+            -o "$out/$name-mitsuba.exr" --variance "$out/$name-mitsuba-variance.exr" \
+            > "$out/$name-mitsuba.json"
+    fi
     "$glint" render "$scene" "${size[@]}" --cpu --spp "$gspp" --seed "$seed" \
         -o "$out/$name-glint.exr" --variance "$out/$name-glint-variance.exr" \
         --json > "$out/$name-glint.json"
@@ -80,6 +88,7 @@ for scene in "${scenes[@]}"; do
         "$out/$name-mitsuba.json")
     if [[ $spectral == True ]]; then
         for channel in 0 1 2; do
+            reused "$name-mitsuba-c$channel" && continue
             python3 "$here/compare.py" "$scene" "${size[@]}" --spp "$mspp" \
                 --runs $((runs - 1)) --seed "$((seed + 1000 * (channel + 1)))" \
                 --integrator "$integrator" --medium-channel "$channel" \
