@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # glint's participating media against Mitsuba 3's volpath, per pixel: for each scene in
-# bench/mitsuba/media/ (a fog box, two smoke spheres with g = 0.7 and -0.5, glass spheres over
-# a medium of chromatic albedo and over one whose σt differs per channel), Mitsuba renders
+# bench/mitsuba/media/ (a fog box, two smoke spheres with g = 0.7 and -0.5, the camera in a
+# sphere of fog, glass spheres over a medium of chromatic albedo and over one whose σt differs
+# per channel; media/dense/ holds a denser one, run on its own), Mitsuba renders
 # RUNS independent images of MSPP spp (compare.py --variance: their mean, and the variance of
 # that mean from their spread), glint's CPU reference renders GSPP spp with its variance
 # image, and `glint compare` runs the per-pixel Z-test on the two. Prints per scene the pass
