@@ -5,7 +5,9 @@
 //! - each strategy (s, t) alone, unweighted, is an unbiased estimate of the light of its path
 //!   length, and the weighted strategies sum to the image;
 //! - renders are reproducible byte for byte, and a render resumed or merged from parts equals
-//!   one made at once (the splat film's fixed-point sums add exactly).
+//!   one made at once (the splat film's fixed-point sums add exactly);
+//! - the variance from batch means (src/render/batch_means.rs, checked in batch_means.rs) is
+//!   the same on the GPU as on the CPU.
 //!
 //! The variance of a bidirectional pixel is not its samples' (light tracing splats into other
 //! pixels), so both integrators' variances come from batch means: `BATCHES` renders with
