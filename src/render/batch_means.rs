@@ -270,7 +270,11 @@ mod tests {
             .wrapping_add(((3 * pixel + c) as u64).wrapping_mul(0xBF58_476D_1CE4_E5B9));
         let h = h ^ (h >> 29);
         let camera = (h % 1000) as f64 / 250.0;
-        let splat = if h.is_multiple_of(7) { (h >> 40) % 50 } else { 0 };
+        let splat = if h.is_multiple_of(7) {
+            (h >> 40) % 50
+        } else {
+            0
+        };
         (camera, splat)
     }
 
