@@ -11,7 +11,7 @@ class RenderResult:
 
     image     H×W×3 float32, the mean radiance per pixel (denoised, with denoise=True)
     raw       with denoise=True: the mean radiance before denoising; else None
-    variance  H×W×3 float32, the variance of each pixel's mean (σ²/n), or None
+    variance  H×W×3 float32, the variance of each pixel's mean (σ²/n; bdpt's from batch means), or None
     albedo, normal, depth   H×W×3 float32 AOVs, or None where not asked for
     stats     dict: spp, seconds (rendering only), wall_seconds (the whole call),
               stopped_by ("spp", "time-limit" or "interrupted"), relative_error, device,

@@ -11,6 +11,7 @@ use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::error::InputError;
 use glint::gpu::{GpuContext, GpuRenderer, Traversal, TraversalChoice};
 use glint::kernel::KernelScene;
+use glint::render::batch_means::BatchMeans;
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use glint::scene::{
     self as scenes, Integrator, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE,
@@ -118,6 +119,9 @@ struct Rendered {
 
 struct Options {
     variance: bool,
+    /// Bidirectional: the variance comes from batch means (src/render/batch_means.rs), as
+    /// `glint render`'s does.
+    batch_means: bool,
     /// Accumulate AOVs (asked for, or for the denoiser).
     aovs: bool,
     denoise: bool,
@@ -133,6 +137,13 @@ fn run(
     stop: &'static AtomicBool,
     signal_error: &mut Option<PyErr>,
 ) -> anyhow::Result<Rendered> {
+    let mut batched;
+    let renderer: &mut dyn Renderer = if options.batch_means {
+        batched = BatchMeans::new(renderer);
+        &mut batched
+    } else {
+        renderer
+    };
     let rules = StopRules {
         time_limit: options.time_limit,
         target_error: None,
@@ -324,18 +335,12 @@ pub fn render<'py>(
         .with_overrides(&overrides)
         .map_err(|m| PyValueError::new_err(format!("{source}: {m}")))?;
     let bdpt = validated.render.integrator == Integrator::Bdpt;
-    if bdpt && variance {
-        // As `glint render --variance` refuses it: light tracing's splats make pixels depend
-        // on one another, which the per-pixel variance assumes they do not.
-        return Err(PyValueError::new_err(
-            "variance: not available with the bdpt integrator yet (its splats make pixels depend on one another)",
-        ));
-    }
     let mut kernel_scene = validated
         .try_kernel_scene()
         .map_err(|e| SceneError::new_err(format!("{source}: {e}")))?;
     let options = Options {
         variance,
+        batch_means: bdpt,
         aovs: aovs || denoise,
         denoise,
         time_limit,

@@ -36,21 +36,23 @@ def test_cpu_render_equals_the_cli_exr_bit_for_bit(cli, cornell, tmp_path):
 
 def test_bdpt_render_equals_the_cli_exr_bit_for_bit(cli, root, tmp_path):
     scene = root / "scenes" / "cornell-glass.toml"
-    out = tmp_path / "cli.exr"
+    out, var = tmp_path / "cli.exr", tmp_path / "cli-var.exr"
     settings = dict(SETTINGS, integrator="bdpt")
-    cli("render", scene, "--cpu", *cli_flags(settings), "-o", out)
+    cli("render", scene, "--cpu", *cli_flags(settings), "-o", out, "--variance", var)
     # device="auto" renders bdpt on the CPU reference, as the command does without --gpu.
-    result = glint.render(glint.load(scene), full=True, **settings)
+    result = glint.render(glint.load(scene), variance=True, **settings)
     assert result.stats["integrator"] == "bdpt"
     assert result.stats["device"] == "cpu"
     assert np.array_equal(result.image.view(np.uint32), glint.read(out).view(np.uint32))
+    # The variance from batch means (1, 1, 2 and 1 samples at 5 spp), as the command's.
+    assert result.variance.mean() > 0
+    assert np.array_equal(result.variance.view(np.uint32), glint.read(var).view(np.uint32))
+    assert result.stats["relative_error"] > 0
     path = glint.render(glint.load(scene), device="cpu", full=True, **dict(settings, integrator="path"))
     assert path.stats["integrator"] == "path"
     assert not np.array_equal(path.image, result.image)
     with pytest.raises(ValueError, match="integrator"):
         glint.render(glint.load(scene), integrator="mlt")
-    with pytest.raises(ValueError, match="bdpt"):
-        glint.render(glint.load(scene), integrator="bdpt", variance=True, spp=1)
 
 
 def test_render_returns_a_plain_array_unless_asked_for_more(cornell):

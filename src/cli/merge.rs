@@ -18,7 +18,8 @@ pub struct MergeArgs {
     /// resumed or merged again) or .png.
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr.
+    /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr;
+    /// bidirectional parts' from their batch means, joined by Chan's update.
     #[arg(long, value_name = "FILE.exr")]
     pub variance: Option<PathBuf>,
     /// Merge even when samples of the render are missing (the image is then of fewer samples).

@@ -12,6 +12,7 @@ use crate::image::output_check::OutputSet;
 use crate::kernel::types::Params;
 use crate::kernel::KernelScene;
 use crate::render::adaptive::{Adaptive, DEFAULT_MIN_SPP};
+use crate::render::batch_means;
 use crate::render::interrupt::{self, Interrupted};
 use crate::render::partial::{format_range, settings_hash, PartialInfo};
 use crate::render::{
@@ -81,13 +82,17 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
     /// Also write the variance of each pixel's mean (σ²/n per channel, linear) to this .exr.
+    /// With --integrator bdpt it is estimated from batch means (light tracing splats into any
+    /// pixel, so a pixel's own samples do not show it): the spread of the means of the sample
+    /// blocks 1, 1, 2, 4, …, 32, then every 64.
     #[arg(long, value_name = "FILE.exr")]
     pub variance: Option<PathBuf>,
     /// Stop at the first batch boundary where the image's relative standard error,
     /// √(mean of the variance image) / (mean of the image), is at most E (checked from 8 spp on).
     /// --spp is then the upper bound, and --time-limit still holds. On a black image (mean 0)
     /// the relative error is undefined, so it never stops the render (a note says so).
-    /// With --adaptive, E is instead each pixel's target (see there).
+    /// With --adaptive, E is instead each pixel's target (see there). With --integrator bdpt the
+    /// variance image comes from batch means (see --variance), and --adaptive is refused.
     #[arg(long, value_name = "E", value_parser = parse_target_error, allow_negative_numbers = true)]
     pub target_error: Option<f64>,
     /// Adaptive sampling: after --adaptive-min-spp samples, a pixel stops taking samples once
@@ -191,7 +196,11 @@ fn make_renderer<'g>(
         }
         _ => Box::new(CpuRenderer::new(kernel_scene)),
     };
-    Ok((renderer, traversal))
+    // Bidirectional renders' variance comes from batch means (src/render/batch_means.rs).
+    Ok((
+        batch_means::for_params(renderer, &kernel_scene.params),
+        traversal,
+    ))
 }
 
 /// The scene `args` ask for, with their overrides; `None` where `--print-scene` printed it
@@ -355,13 +364,11 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     args.post.check()?;
 
-    if scene.render.integrator == Integrator::Bdpt
-        && (args.variance.is_some() || args.target_error.is_some())
-    {
-        // Splats break the per-pixel independence the variance image rests on; batch means
-        // would estimate it, and are not built yet.
+    if scene.render.integrator == Integrator::Bdpt && args.adaptive {
+        // Its variance comes from batch means of every pixel's samples (light tracing splats
+        // into any pixel), which a pixel that stopped early would not have.
         return Err(InputError(
-            "--variance and --target-error are not available with the bdpt integrator yet (its splats make pixels depend on one another)".into(),
+            "--adaptive is not available with the bdpt integrator (its variance comes from batch means of every pixel's samples); --target-error alone stops the whole render".into(),
         )
         .into());
     }

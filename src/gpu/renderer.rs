@@ -561,6 +561,7 @@ impl Renderer for GpuRenderer<'_> {
             m2: self.read_vec3s(&self.images.m2)?,
             splats: self.read_splats()?,
             splat_scale: self.params.splat_scale,
+            batches: 0,
         })
     }
 

@@ -4,6 +4,7 @@
 
 pub mod accumulation;
 pub mod adaptive;
+pub mod batch_means;
 pub mod bench;
 pub mod interrupt;
 pub mod merge;

@@ -37,7 +37,9 @@ const COUNT_CHANNEL: &str = "N";
 const MEAN_CHANNELS: [&str; 3] = ["R", "G", "B"];
 const M2_CHANNELS: [&str; 3] = ["M2.R", "M2.G", "M2.B"];
 /// Bidirectional renders: the camera strategies' own mean (RGB holds the image, splats
-/// added), and the splat film's 64-bit sums as two 32-bit unsigned words per channel.
+/// added), and the splat film's 64-bit sums as two 32-bit unsigned words per channel. Their
+/// M2 channels hold the sum of squares between batch means, over the batches the header's
+/// `glint.batches` says (`src/render/batch_means.rs`).
 const CAMERA_CHANNELS: [&str; 3] = ["Camera.R", "Camera.G", "Camera.B"];
 const SPLAT_CHANNELS: [[&str; 2]; 3] = [
     ["Splat.R.high", "Splat.R.low"],
@@ -290,6 +292,9 @@ impl Partial {
             attributes
                 .other
                 .insert(Text::from("glint.splat_scale"), text(&scale));
+            attributes
+                .other
+                .insert(Text::from("glint.batches"), text(&a.batches.to_string()));
         }
         let layer = Layer::new(
             (a.width as usize, a.height as usize),
@@ -435,6 +440,7 @@ impl Partial {
             .any(|c| c.name == *CAMERA_CHANNELS[0]);
         let mut splats = Vec::new();
         let mut splat_scale = 0.0;
+        let mut batches = 0;
         if has_splats {
             let word = |name: &str| -> Result<&[u32], String> {
                 let found = layer
@@ -467,6 +473,17 @@ impl Partial {
                 return Err(fail(
                     "the attribute glint.splat_scale is not a positive number".into(),
                 ));
+            }
+            // The M2 channels are the sum of squares between this many batch means.
+            batches = text_attribute(&layer.attributes.other, "glint.batches")
+                .and_then(|s| s.parse::<u32>().ok())
+                .ok_or_else(|| {
+                    fail("the attribute glint.batches is missing or not a whole number (a bidirectional render from a glint before its variance came from batch means: render it again)".into())
+                })?;
+            if (count > 0 && batches == 0) || batches > count {
+                return Err(fail(format!(
+                    "glint.batches is {batches}, impossible for {count} samples per pixel"
+                )));
             }
         }
         let counts = if format == FORMAT_COUNTS {
@@ -509,6 +526,7 @@ impl Partial {
             m2: gather(M2_CHANNELS)?,
             splats,
             splat_scale,
+            batches,
         };
         Ok(Partial { info, accumulation })
     }

@@ -377,6 +377,7 @@ fn adaptive_shards_merge_pixel_by_pixel() {
         m2: full.iter().map(|&i| a.m2[i]).collect(),
         splats: Vec::new(),
         splat_scale: 0.0,
+        batches: 0,
     };
     let worst = crate::common::merge_bound::worst_vs_bound(&pick(m), &pick(p));
     assert!(worst <= 1.0, "{worst}");

@@ -5,7 +5,9 @@
 //! - each strategy (s, t) alone, unweighted, is an unbiased estimate of the light of its path
 //!   length, and the weighted strategies sum to the image;
 //! - renders are reproducible byte for byte, and a render resumed or merged from parts equals
-//!   one made at once (the splat film's fixed-point sums add exactly).
+//!   one made at once (the splat film's fixed-point sums add exactly);
+//! - the variance from batch means (src/render/batch_means.rs, checked in batch_means.rs) is
+//!   the same on the GPU as on the CPU.
 //!
 //! The variance of a bidirectional pixel is not its samples' (light tracing splats into other
 //! pixels), so both integrators' variances come from batch means: `BATCHES` renders with
@@ -27,6 +29,7 @@ use glint::kernel::types::{INTEGRATOR_BDPT, INTEGRATOR_PATH};
 use glint::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 use glint::kernel::KernelScene;
 use glint::render::accumulation::Accumulation;
+use glint::render::batch_means::BatchMeans;
 use glint::render::Renderer;
 
 const BATCHES: u32 = 16;
@@ -609,4 +612,39 @@ fn gpu_bdpt_renders_are_reproducible_and_merge_exactly() {
     merged.merge(&second.read_accumulation().unwrap());
     assert_eq!(merged.splats, once.splats);
     assert_eq!(merged.mean_image().pixels, once.mean_image().pixels);
+}
+
+/// The variance from batch means (src/render/batch_means.rs) is the same on both devices: the
+/// GPU traces the CPU's paths (above), and the batch means are taken on the host from either's
+/// accumulation. The glass box at 12², 16 spp (5 batches), the kernel the tests above compile.
+/// A path or splat that differs in its last bits (see above) moves a pixel's variance a little,
+/// so 99% of the pixel channels must agree to 1e-3 of their variance, and the image means to
+/// 1e-3; a batch cut in another place, or a missing splat term, moves nearly all of them.
+#[test]
+fn gpu_batch_means_variance_is_the_cpus() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = gpu_scenes(12, 3).remove(0).1;
+    let mut gpu = BatchMeans::new(Box::new(gpu_renderer(ctx, &scene)));
+    let mut cpu = BatchMeans::new(Box::new(CpuRenderer::new(&scene)));
+    let (mut agree, mut channels) = (0, 0);
+    for batch in [3, 13] {
+        gpu.add_samples(batch).unwrap();
+        cpu.add_samples(batch).unwrap();
+    }
+    let (g, c) = (gpu.read_variance().unwrap(), cpu.read_variance().unwrap());
+    assert_eq!(gpu.read_accumulation().unwrap().batches, 6);
+    for (a, b) in g.pixels.iter().zip(&c.pixels) {
+        for ch in 0..3 {
+            channels += 1;
+            agree += ((a[ch] - b[ch]).abs() <= 1e-3 * a[ch].max(b[ch])) as usize;
+        }
+    }
+    let means = (g.mean(), c.mean());
+    eprintln!("variance: {agree} of {channels} channels agree to 1e-3; image means {means:?}");
+    assert!(c.mean() > 0.0);
+    assert!((means.0 / means.1 - 1.0).abs() < 1e-3, "{means:?}");
+    assert!(
+        agree as f64 >= 0.99 * channels as f64,
+        "{agree} of {channels}"
+    );
 }

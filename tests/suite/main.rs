@@ -47,6 +47,7 @@ mod transmission;
 
 // Lights, the environment and the integrator's statistics.
 mod adaptive;
+mod batch_means;
 mod bdpt;
 mod chi2;
 mod closed_form;

@@ -88,6 +88,7 @@ impl Renderer for CpuRenderer {
                 Vec::new()
             },
             splat_scale: self.scene.params.splat_scale,
+            batches: 0,
         })
     }
 
