@@ -33,7 +33,7 @@ struct Accumulator {
 }
 
 // Whether adaptive sampling has stopped the pixel: the host marks it by a non-zero w in its M2
-// (src/gpu/renderer.rs), which the kernel's own writes leave 0 (render() in path.wgsl).
+// (src/gpu/renderer.rs), which the kernel's own writes leave 0 (finish_pixel in pixel.wgsl).
 fn pixel_stopped(pixel: u32) -> bool {
     return accum_m2[pixel].w != 0.0;
 }

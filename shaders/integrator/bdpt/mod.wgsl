@@ -49,16 +49,12 @@ fn bdpt_sample(id: SampleId, aov: ptr<function, PathAov>) -> vec3<f32> {
 // less (two subpaths and their joins), and its joins run in loops of their own.
 @compute @workgroup_size(8, 8, 1)
 fn render_bdpt(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let px = gid.x + tile_origin.x;
-    let py = gid.y + tile_origin.y;
-    if px >= params.width || py >= params.height || params.sample_count == 0u {
+    let pixel = invocation_pixel(gid);
+    if pixel == NO_PIXEL {
         return;
     }
-    let pixel = py * params.width + px;
-    // Adaptive sampling: a pixel the host has stopped takes no more samples (accumulate.wgsl).
-    if pixel_stopped(pixel) {
-        return;
-    }
+    let px = pixel % params.width;
+    let py = pixel / params.width;
     var acc = accumulator_start(params.accumulated_samples, accum_mean[pixel].xyz, accum_m2[pixel].xyz);
     var aov_mean = aov_mean_start();
     var done = 0u;
@@ -90,15 +86,5 @@ fn render_bdpt(@builtin(global_invocation_id) gid: vec3<u32>) {
         atomicAdd(&accumulate_counters[1], 1u);
         return;
     }
-    // A batch the host ends inside a block keeps the statistics right.
-    merge_block(&acc);
-    accum_mean[pixel] = vec4<f32>(acc.mean, 0.0);
-    accum_m2[pixel] = vec4<f32>(acc.m2, 0.0);
-    if aovs_on() {
-        aov_merge(pixel, aov_mean, f32(params.accumulated_samples), f32(params.sample_count));
-    }
-    atomicAdd(&segments_traced, segments);
-    if acc.nonfinite > 0u {
-        atomicAdd(&accumulate_counters[0], acc.nonfinite);
-    }
+    finish_pixel(pixel, &acc, aov_mean);
 }

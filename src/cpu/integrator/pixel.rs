@@ -1,6 +1,7 @@
 //! The kernel's entry point for one pixel (WGSL side: the `render` entry point of
 //! `shaders/integrator/path.wgsl` for path tracing, `render_bdpt` of
-//! `shaders/integrator/bdpt/mod.wgsl` for bidirectional: the kernel compiles the integrator
+//! `shaders/integrator/bdpt/mod.wgsl` for bidirectional, around the pixel choice and the
+//! writes they share in `shaders/integrator/pixel.wgsl`: the kernel compiles the integrator
 //! in, where this branches on it): its samples, by the integrator `Params::integrator` names,
 //! merged into its statistics.
 
