@@ -2,7 +2,9 @@
 
 use crate::cpu::core::camera::camera_ray;
 use crate::cpu::core::ray::Ray;
-use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
+use crate::cpu::core::rng::{
+    stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE, PURPOSE_TRACKING,
+};
 use crate::cpu::geometry::alpha::alpha_segment_key;
 use crate::cpu::geometry::hit::{Hit, NO_HIT};
 use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene};
@@ -350,7 +352,16 @@ fn add_unblocked_light<const MEDIA: bool>(
         if light.dir.dot(hit.normal) < 0.0 {
             media = medium_crossed(params, &media, hit.material, hit.front_face);
         }
-        through = shadow_transmittance(shadow_scene, &shadow, light, &media, segments);
+        let stream = stream_id(bounce, PURPOSE_TRACKING);
+        let mut tracking = Rng::with_sampler(pixel, sample, stream, params.seed, params.sampler);
+        through = shadow_transmittance(
+            shadow_scene,
+            &shadow,
+            light,
+            &media,
+            segments,
+            &mut tracking,
+        );
         if !through.cmpgt(Vec3::ZERO).any() {
             return;
         }

@@ -15,14 +15,16 @@
 //! Georgiev and Jarosz 2019), so chromatic media are unbiased in every channel.
 
 use crate::cpu::core::ray::Ray;
+use crate::cpu::core::rng::Rng;
 use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::geometry::intersect::intersect_scene;
 use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::lights::light_sample::LightSample;
+use crate::cpu::media::grid::grid_transmittance;
 use crate::cpu::scene_refs::SceneRefs;
 use crate::kernel::types::{
-    Material, Medium, Params, LIGHT_SUN, MATERIAL_DIELECTRIC, NO_MEDIUM, PRIMITIVE_ENVIRONMENT,
-    PRIMITIVE_LIGHT,
+    Material, Medium, Params, LIGHT_SUN, MATERIAL_DIELECTRIC, NO_GRID, NO_MEDIUM,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT,
 };
 use glam::Vec3;
 
@@ -121,6 +123,25 @@ pub fn transmittance(sigma_t: Vec3, d: f32) -> Vec3 {
     Vec3::new(channel(sigma_t.x), channel(sigma_t.y), channel(sigma_t.z))
 }
 
+/// The transmittance of medium slot `slot` ([`NO_MEDIUM`]: none) along `ray` from 0 to `t`:
+/// Beer's law in a homogeneous medium, ratio tracking in a grid medium.
+pub fn segment_transmittance(
+    scene: &SceneRefs,
+    slot: u32,
+    ray: &Ray,
+    t: f32,
+    rng: &mut Rng,
+) -> Vec3 {
+    if slot == NO_MEDIUM {
+        return Vec3::ONE;
+    }
+    let m = &scene.params.media[slot as usize];
+    if m.grid != NO_GRID {
+        return grid_transmittance(scene.grids, m, ray, t, rng);
+    }
+    transmittance(Vec3::from(m.sigma_t), t)
+}
+
 /// A free flight: where it ended, and the factor the path's throughput takes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FreeFlight {
@@ -168,13 +189,15 @@ pub fn sample_free_flight(m: &Medium, t_max: f32, u_channel: f32, u_distance: f3
 /// The transmittance from the shadow ray's origin (in the media of `stack`) to the sampled
 /// light: Beer's law over each segment, through interfaces, which change the medium as a path
 /// crossing them would; zero where anything else blocks it. `scene` carries the shadow ray's
-/// alpha key. Counts the rays it casts in `segments`.
+/// alpha key. Counts the rays it casts in `segments`. Grid media's segments are ratio
+/// tracked, drawing from `rng` (the vertex's `PURPOSE_TRACKING` stream).
 pub fn shadow_transmittance(
     scene: &SceneRefs,
     shadow: &Ray,
     light: &LightSample,
     stack: &MediumStack,
     segments: &mut u32,
+    rng: &mut Rng,
 ) -> Vec3 {
     let params = scene.params;
     let mut ray = *shadow;
@@ -207,18 +230,13 @@ pub fn shadow_transmittance(
             t_light = hit.t;
         }
         let slot = current_medium(params, &media);
-        let sigma_t = if slot == NO_MEDIUM {
-            Vec3::ZERO
-        } else {
-            Vec3::from(params.media[slot as usize].sigma_t)
-        };
         if t_light >= 0.0 {
-            return through * transmittance(sigma_t, t_light);
+            return through * segment_transmittance(scene, slot, &ray, t_light, rng);
         }
         if hit.t == NO_HIT || !is_interface(&scene.materials[hit.material as usize]) {
             return Vec3::ZERO;
         }
-        through *= transmittance(sigma_t, hit.t);
+        through *= segment_transmittance(scene, slot, &ray, hit.t, rng);
         media = medium_crossed(params, &media, hit.material, hit.front_face);
         ray = Ray {
             origin: offset_ray_origin(hit.position, hit.error, -hit.normal),
