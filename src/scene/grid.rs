@@ -112,14 +112,40 @@ pub fn parse_density_grid(
         ));
     }
     // vdb-rs panics (asserts, unimplemented versions, unwraps) on some files it cannot read,
-    // truncated or broken ones among them: a panic there is a broken file, not a crash.
-    let parsed = std::panic::catch_unwind(|| read_with_vdb_rs(bytes, grid_name, shown));
+    // truncated or broken ones among them: a panic there is a broken file, not a crash, and
+    // its message is not printed (the error below says what is wrong).
+    let parsed = quietly(|| read_with_vdb_rs(bytes, grid_name, shown));
     match parsed {
         Ok(result) => result,
         Err(_) => Err(format!(
-            "{shown} is a broken or unsupported OpenVDB file (the reader failed on it)"
+            "{shown} is a broken or unsupported OpenVDB file (the reader failed on it; it \
+             reads files of OpenVDB 2.1 and later whose grids have a scale and translation \
+             transform)"
         )),
     }
+}
+
+thread_local! {
+    /// Set while this thread runs the reader under [`quietly`].
+    static QUIET: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Runs `f`, catching a panic, whose message the panic hook then leaves out (on this thread
+/// only: other threads' panics print as before).
+fn quietly<T>(f: impl FnOnce() -> T + std::panic::UnwindSafe) -> std::thread::Result<T> {
+    static HOOK: std::sync::Once = std::sync::Once::new();
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(|q| q.get()) {
+                previous(info);
+            }
+        }));
+    });
+    QUIET.with(|q| q.set(true));
+    let result = std::panic::catch_unwind(f);
+    QUIET.with(|q| q.set(false));
+    result
 }
 
 /// The grid types glint reads: 32-bit float grids (also those saved as half floats).

@@ -467,3 +467,41 @@ fn bad_grids_are_refused_with_named_errors() {
         );
     }
 }
+
+/// `glint render` on a scene whose grid file the reader panics on (a transform map it does
+/// not know, named as OpenVDB names its maps) exits 2 with the named error and no panic
+/// message; so does one cut short (an input error).
+#[test]
+fn glint_render_refuses_unreadable_grids_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = write_vdb(&[smooth_grid()]);
+    let at = whole
+        .windows(17)
+        .position(|w| w == b"ScaleTranslateMap")
+        .unwrap();
+    let mut unknown = whole.clone();
+    unknown[at..at + 17].copy_from_slice(b"UnknownMapOfSorts");
+    std::fs::write(dir.path().join("map.vdb"), &unknown).unwrap();
+    std::fs::write(dir.path().join("cut.vdb"), &whole[..whole.len() / 2]).unwrap();
+    for (file, needle) in [
+        ("map.vdb", "the reader failed"),
+        ("cut.vdb", "UnexpectedEof"),
+    ] {
+        let more = format!(
+            "[media.smoke]\ngrid = \"{file}\"\nsigma_s = [1.0, 1.0, 1.0]\n\
+             [[volumes]]\nmedium = \"smoke\"\n"
+        );
+        std::fs::write(dir.path().join("s.toml"), scene_text(&more, 8, 1, 1)).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+            .args(["render", "s.toml", "--cpu", "-o", "s.png"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
+        for want in ["media.smoke.grid", file, needle] {
+            assert!(err.contains(want), "{file}: {want:?} not in {err}");
+        }
+        assert!(!err.contains("panicked"), "{file}: {err}");
+    }
+}
