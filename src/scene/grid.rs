@@ -111,6 +111,16 @@ pub fn parse_density_grid(
             "{shown} is not an OpenVDB file (it does not start with the VDB magic number)"
         ));
     }
+    // The byte after the magic and three versions says whether the grids' stream positions
+    // follow their descriptors: OpenVDB writes them to files, not to streams (Blender's
+    // geometry node bakes write their volumes so), and vdb-rs reads only the former.
+    if bytes.len() > 20 && bytes[20] == 0 {
+        return Err(format!(
+            "{shown} is an OpenVDB stream without grid offsets (as Blender's geometry node \
+             bakes write volumes), which glint's reader cannot read: save the grid as a VDB \
+             file (OpenVDB's io::File, as Blender's fluid caches and most tools write)"
+        ));
+    }
     // vdb-rs panics (asserts, unimplemented versions, unwraps) on some files it cannot read,
     // truncated or broken ones among them: a panic there is a broken file, not a crash, and
     // its message is not printed (the error below says what is wrong).

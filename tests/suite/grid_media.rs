@@ -321,7 +321,7 @@ fn gpu_and_cpu_trace_the_same_paths_through_a_grid() {
 }
 
 /// The refusals, each naming the field and the file: a missing file, one that is not a VDB,
-/// a vector grid, a grid name the file lacks, negative and non-finite densities, a grid too
+/// an OpenVDB stream without grid offsets, a vector grid, a grid name the file lacks, negative and non-finite densities, a grid too
 /// large for one GPU binding, a grid medium filling a sphere, a volume of a homogeneous
 /// medium, and every truncation of a valid file (an error, never a panic); a half-float grid
 /// reads.
@@ -405,6 +405,11 @@ fn bad_grids_are_refused_with_named_errors() {
         "",
         &["4001 × 4001 × 4001 voxels", "MiB one GPU binding holds"],
     );
+
+    let mut stream = write_vdb(&[smooth_grid()]);
+    stream[20] = 0;
+    std::fs::write(path.join("stream.vdb"), stream).unwrap();
+    refuse("stream.vdb", "", &["stream.vdb", "without grid offsets"]);
 
     // Placing: a grid medium fills no sphere; a volume needs a grid medium.
     std::fs::write(path.join("ok.vdb"), write_vdb(&[smooth_grid()])).unwrap();
