@@ -3,7 +3,7 @@
 OpenVDB file of one float grid, "density", saved as half floats with zlib compression as
 OpenVDB 11 writes them. Python's standard library only:
 
-    python3 scenes/tools/make_smoke.py [--size 48] [--out scenes/smoke.vdb]
+    python3 scenes/tools/make_smoke.py [--size 48] [--out scenes/smoke.vdb] [--blosc] [--active-mask]
 
 The file (a few hundred KB) is not kept in the repository; this script is. Blender's smoke
 (mantaflow) bakes would be the natural source, but the `bpy` module's headless bake fails in
@@ -83,10 +83,24 @@ def mask(bits, count):
     return bytes(out)
 
 
-def values(vals):
+BLOSC = None
+ACTIVE_MASK = False
+
+
+def values(vals, active=None):
+    """A node's values: all of them (metadata 6), or with active-mask compression only the
+    active ones, the inactive all 0 (metadata 0), as OpenVDB writes by default."""
+    if ACTIVE_MASK:
+        vals = [vals[i] for i in sorted(active or ())]
+        if not vals:
+            return bytes([0]) + struct.pack("<q", 0)
     raw = struct.pack("<%de" % len(vals), *vals)
-    z = zlib.compress(raw)
-    return bytes([6]) + struct.pack("<q", len(z)) + z
+    if BLOSC:
+        # As OpenVDB's bloscToStream: LZ4, level 9, byte shuffle, the value's size as typesize.
+        z = BLOSC.compress(raw, typesize=2, clevel=9, shuffle=BLOSC.SHUFFLE, cname="lz4")
+    else:
+        z = zlib.compress(raw)
+    return bytes([0 if ACTIVE_MASK else 6]) + struct.pack("<q", len(z)) + z
 
 
 def write_vdb(voxels, voxel_size, translation):
@@ -100,7 +114,8 @@ def write_vdb(voxels, voxel_size, translation):
     head += b"5f0d3a52-7c1e-4b8e-9a51-2d7e4c3b9f10" + struct.pack("<I", 0) + struct.pack("<I", 1)
     head += string("density") + string("Tree_float_5_4_3") + string("")
     grid_pos = len(head) + 24
-    grid = struct.pack("<I", 1)  # zip, no active mask
+    # Blosc or zip, with or without active-mask compression.
+    grid = struct.pack("<I", (4 if BLOSC else 1) | (2 if ACTIVE_MASK else 0))
     meta = [("class", "string", b"fog volume"), ("is_saved_as_half_float", "bool", b"\x01")]
     grid += struct.pack("<I", len(meta))
     for name, ty, data in meta:
@@ -121,7 +136,7 @@ def write_vdb(voxels, voxel_size, translation):
     for i5 in sorted(tree):
         for i4 in sorted(tree[i5]):
             leaf = tree[i5][i4]
-            grid += mask(leaf, 512) + values([leaf.get(i, 0.0) for i in range(512)])
+            grid += mask(leaf, 512) + values([leaf.get(i, 0.0) for i in range(512)], leaf)
     end_pos = grid_pos + len(grid)
     return head + struct.pack("<QQQ", grid_pos, block_pos, end_pos) + grid
 
@@ -132,7 +147,24 @@ def main():
     parser.add_argument(
         "--out", default=os.path.join(os.path.dirname(__file__), "..", "smoke.vdb")
     )
+    parser.add_argument(
+        "--blosc",
+        action="store_true",
+        help="Blosc (LZ4) compression, as Blender's caches default to (needs `pip install blosc`)",
+    )
+    parser.add_argument(
+        "--active-mask",
+        action="store_true",
+        help="write only active values (OpenVDB's default, and Blender's)",
+    )
     args = parser.parse_args()
+    global ACTIVE_MASK
+    ACTIVE_MASK = args.active_mask
+    if args.blosc:
+        global BLOSC  # noqa: PLW0603
+        import blosc
+
+        BLOSC = blosc
     n = args.size
     voxels = plume(n)
     # 2 units across, 4 high, its base centred on the origin.
