@@ -2,9 +2,7 @@
 
 use crate::cpu::core::camera::camera_ray;
 use crate::cpu::core::ray::Ray;
-use crate::cpu::core::rng::{
-    stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE, PURPOSE_TRACKING,
-};
+use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_BSDF, PURPOSE_LIGHT, PURPOSE_ROULETTE};
 use crate::cpu::geometry::alpha::alpha_segment_key;
 use crate::cpu::geometry::hit::{Hit, NO_HIT};
 use crate::cpu::geometry::intersect::{crosses_shading_side, intersect_scene};
@@ -18,7 +16,7 @@ use crate::cpu::lights::punctual::sun_disks_radiance;
 use crate::cpu::lights::sampling::{light_pdf, light_visible, sample_light};
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
 use crate::cpu::media::medium::{
-    is_interface, medium_crossed, medium_start, shadow_transmittance, MediumStack,
+    is_interface, medium_crossed, medium_start, shadow_transmittance, MediumStack, TrackingStream,
 };
 use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::normal_map::normal_mapped;
@@ -352,16 +350,12 @@ fn add_unblocked_light<const MEDIA: bool>(
         if light.dir.dot(hit.normal) < 0.0 {
             media = medium_crossed(params, &media, hit.material, hit.front_face);
         }
-        let stream = stream_id(bounce, PURPOSE_TRACKING);
-        let mut tracking = Rng::with_sampler(pixel, sample, stream, params.seed, params.sampler);
-        through = shadow_transmittance(
-            shadow_scene,
-            &shadow,
-            light,
-            &media,
-            segments,
-            &mut tracking,
-        );
+        let tracking = TrackingStream {
+            pixel,
+            sample,
+            bounce,
+        };
+        through = shadow_transmittance(shadow_scene, &shadow, light, &media, segments, tracking);
         if !through.cmpgt(Vec3::ZERO).any() {
             return;
         }

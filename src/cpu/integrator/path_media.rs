@@ -6,7 +6,6 @@
 use crate::cpu::core::ray::Ray;
 use crate::cpu::core::rng::{
     stream_id, Rng, PURPOSE_FREE_FLIGHT, PURPOSE_MEDIUM_LIGHT, PURPOSE_PHASE, PURPOSE_ROULETTE,
-    PURPOSE_TRACKING,
 };
 use crate::cpu::geometry::alpha::alpha_segment_key;
 use crate::cpu::geometry::hit::Hit;
@@ -17,6 +16,7 @@ use crate::cpu::lights::sampling::sample_light;
 use crate::cpu::media::grid::grid_free_flight;
 use crate::cpu::media::medium::{
     current_medium, medium_crossed, sample_free_flight, shadow_transmittance, FreeFlight,
+    TrackingStream,
 };
 use crate::cpu::media::phase::{hg_phase, sample_hg};
 use crate::cpu::scene_refs::SceneRefs;
@@ -93,16 +93,18 @@ pub fn medium_vertex(
                 origin: position,
                 dir: light.dir,
             };
-            let stream = stream_id(bounce, PURPOSE_TRACKING);
-            let mut tracking =
-                Rng::with_sampler(pixel, sample, stream, params.seed, params.sampler);
+            let tracking = TrackingStream {
+                pixel,
+                sample,
+                bounce,
+            };
             let through = shadow_transmittance(
                 shadow_scene,
                 &shadow,
                 &light,
                 &path.media,
                 segments,
-                &mut tracking,
+                tracking,
             );
             if through.cmpgt(Vec3::ZERO).any() {
                 let weight = nee_weight(&light, phase);
