@@ -13,6 +13,7 @@ const PURPOSE_ROULETTE: u32 = 2u;
 const PURPOSE_FREE_FLIGHT: u32 = 3u;
 const PURPOSE_PHASE: u32 = 4u;
 const PURPOSE_MEDIUM_LIGHT: u32 = 5u;
+const PURPOSE_TRACKING: u32 = 6u;
 
 const SAMPLER_INDEPENDENT: u32 = 0u;
 const SAMPLER_SOBOL: u32 = 1u;

@@ -72,11 +72,29 @@ const NO_MEDIUM: u32 = 0xffffffffu;
 
 // A homogeneous medium (src/kernel/types.rs): extinction and scattering per unit length,
 // Henyey-Greenstein's g, and the material whose objects bound it, or NO_MEDIUM.
+// A grid medium's coefficients are per unit density, and grid indexes grids (NO_GRID: a
+// homogeneous medium).
 struct Medium {
     sigma_t: vec3<f32>,
     g: f32,
     sigma_s: vec3<f32>,
     boundary: u32,
+    grid: u32,
+}
+
+const NO_GRID: u32 = 0xffffffffu;
+
+// A density grid (src/kernel/types.rs): scene to grid coordinates (rows of a 3 x 4 matrix),
+// the dense densities from `voxels` in grid_voxels, the blocks' majorants from `majorants`.
+struct GridMedium {
+    to_grid_x: vec4<f32>,
+    to_grid_y: vec4<f32>,
+    to_grid_z: vec4<f32>,
+    dims: vec3<u32>,
+    voxels: u32,
+    blocks: vec3<u32>,
+    majorants: u32,
+    block: u32,
 }
 
 const INTEGRATOR_PATH: u32 = 0u;

@@ -212,7 +212,7 @@ fn add_unblocked_light(
         if dot(light.dir, hit.normal) < 0.0 {
             media = medium_crossed(media, hit.material, hit.front_face);
         }
-        through = shadow_transmittance(Ray(shadow_origin, light.dir), light, media);
+        through = shadow_transmittance(Ray(shadow_origin, light.dir), light, media, pixel, sample, bounce);
         if !any(through > vec3<f32>(0.0)) {
             return;
         }

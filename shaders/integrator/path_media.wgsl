@@ -8,9 +8,15 @@ fn free_flight(path: ptr<function, PathState>, t_hit: f32, pixel: u32, sample: u
         return FreeFlight(t_hit, vec3<f32>(1.0), false);
     }
     var rng = rng_stream(pixel, sample, stream_id((*path).bounce, PURPOSE_FREE_FLIGHT), params.seed, params.sampler);
-    let u_channel = rng_next(&rng);
-    let u_distance = rng_next(&rng);
-    let flight = sample_free_flight(params.media[slot], t_hit, u_channel, u_distance);
+    let m = params.media[slot];
+    var flight: FreeFlight;
+    if HAS_GRID_MEDIA && m.grid != NO_GRID {
+        flight = grid_free_flight(m, (*path).ray, t_hit, &rng);
+    } else {
+        let u_channel = rng_next(&rng);
+        let u_distance = rng_next(&rng);
+        flight = sample_free_flight(m, t_hit, u_channel, u_distance);
+    }
     (*path).throughput *= flight.weight;
     return flight;
 }
@@ -34,7 +40,7 @@ fn medium_vertex(path: ptr<function, PathState>, position: vec3<f32>, light_samp
             if HAS_ALPHA {
                 alpha_key = alpha_segment_key(pixel, sample, bounce + 1u);
             }
-            let through = shadow_transmittance(Ray(position, light.dir), light, (*path).media);
+            let through = shadow_transmittance(Ray(position, light.dir), light, (*path).media, pixel, sample, bounce);
             if any(through > vec3<f32>(0.0)) {
                 let weight = nee_weight(light, phase);
                 let contribution = (*path).throughput * through * light.radiance * (phase * weight / light.pdf);

@@ -79,6 +79,18 @@ fn transmittance(sigma_t: vec3<f32>, d: f32) -> vec3<f32> {
     return select(vec3<f32>(1.0), exp(-(sigma_t * d)), sigma_t > vec3<f32>(0.0));
 }
 
+// Beer's law in a homogeneous medium, ratio tracking in a grid medium; 1 outside media.
+fn segment_transmittance(slot: u32, ray: Ray, t: f32, rng: ptr<function, Rng>) -> vec3<f32> {
+    if slot == NO_MEDIUM {
+        return vec3<f32>(1.0);
+    }
+    let m = params.media[slot];
+    if HAS_GRID_MEDIA && m.grid != NO_GRID {
+        return grid_transmittance(m, ray, t, rng);
+    }
+    return transmittance(m.sigma_t, t);
+}
+
 struct FreeFlight {
     t: f32,
     weight: vec3<f32>,
@@ -110,7 +122,12 @@ fn sample_free_flight(m: Medium, t_max: f32, u_channel: f32, u_distance: f32) ->
 
 // The transmittance from the shadow ray's origin (in the media of stack) to the sampled light,
 // through interfaces; zero where anything else blocks it. Uses the alpha key the caller set.
-fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack) -> vec3<f32> {
+// Grid media's segments are ratio tracked, drawing from the vertex's PURPOSE_TRACKING stream.
+fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack, pixel: u32, sample: u32, bounce: u32) -> vec3<f32> {
+    var tracking: Rng;
+    if HAS_GRID_MEDIA {
+        tracking = rng_stream(pixel, sample, stream_id(bounce, PURPOSE_TRACKING), params.seed, params.sampler);
+    }
     var ray = shadow;
     var media = stack;
     var through = vec3<f32>(1.0);
@@ -140,17 +157,13 @@ fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack) -> 
             t_light = hit.t;
         }
         let slot = current_medium(media);
-        var sigma_t = vec3<f32>(0.0);
-        if slot != NO_MEDIUM {
-            sigma_t = params.media[slot].sigma_t;
-        }
         if t_light >= 0.0 {
-            return through * transmittance(sigma_t, t_light);
+            return through * segment_transmittance(slot, ray, t_light, &tracking);
         }
         if hit.t == NO_HIT || !is_interface(materials[hit.material]) {
             return vec3<f32>(0.0);
         }
-        through *= transmittance(sigma_t, hit.t);
+        through *= segment_transmittance(slot, ray, hit.t, &tracking);
         media = medium_crossed(media, hit.material, hit.front_face);
         ray = Ray(offset_ray_origin(hit.position, hit.error, -hit.normal), ray.dir);
     }

@@ -34,7 +34,7 @@ fn free_flight(path: ptr<function, PathState>, t_hit: f32, pixel: u32, sample: u
     return FreeFlight(t_hit, vec3<f32>(1.0), false);
 }
 
-fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack) -> vec3<f32> {
+fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack, pixel: u32, sample: u32, bounce: u32) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 

@@ -5,6 +5,7 @@
 
 use crate::cpu::geometry::alpha::AlphaTest;
 use crate::cpu::geometry::scene_geometry::Geometry;
+use crate::cpu::media::grid::Grids;
 use crate::cpu::textures::texture::Textures;
 use crate::kernel::bvh::layout::BvhLayout;
 use crate::kernel::types::{
@@ -32,6 +33,8 @@ pub struct SceneRefs<'a> {
     pub environment_alias: &'a [EnvironmentAlias],
     /// Point, spot and directional lights (`punctual.rs`).
     pub lights: &'a [Light],
+    /// Grid media's grids (`src/cpu/media/grid.rs`); empty without them.
+    pub grids: Grids<'a>,
     /// The surfaces, as intersection reads them: spheres, quads, triangles with their normals
     /// and texture coordinates, the BVHs and instances, and the key of the ray segment being
     /// traced (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`.
@@ -58,6 +61,10 @@ impl<'a> SceneRefs<'a> {
             triangle_tangents: &scene.triangle_tangents,
             triangle_colors: &scene.triangle_colors,
             lights: &scene.lights,
+            grids: Grids {
+                grids: &scene.grids,
+                voxels: &scene.grid_voxels,
+            },
             geometry: Geometry {
                 spheres: &scene.spheres,
                 quads: &scene.quads,

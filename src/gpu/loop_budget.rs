@@ -59,7 +59,20 @@ pub fn loop_iterations_per_ray(scene: &KernelScene) -> u64 {
 /// looks for sun disks among the lights, and the path loop makes one more (light sampling
 /// picks its emitter from the alias table, without a loop).
 pub fn loop_iterations_per_sample(scene: &KernelScene) -> u64 {
-    sample_iterations(&scene.params, loop_iterations_per_ray(scene))
+    sample_iterations(&scene.params, loop_iterations_per_ray(scene)) + grid_iterations(scene)
+}
+
+/// What grid media add to a sample (`src/cpu/media/grid.rs`): each segment's free flight and
+/// each shadow segment's ratio tracking take at most `MAX_TRACKING_STEPS` iterations, plus
+/// the three of each lookup's clip and walk set-up.
+fn grid_iterations(scene: &KernelScene) -> u64 {
+    if scene.grids.is_empty() || scene.params.medium_count == 0 {
+        return 0;
+    }
+    let segments = scene.params.max_bounces as u64 + 1;
+    let crossings = crate::cpu::media::medium::MAX_SHADOW_CROSSINGS as u64;
+    let per_track = crate::cpu::media::grid::MAX_TRACKING_STEPS as u64 + 6;
+    segments * (1 + crossings) * per_track
 }
 
 /// [`loop_iterations_per_sample`] for the hardware traversal (shaders/traverse/hardware.wgsl),
@@ -69,6 +82,7 @@ pub fn loop_iterations_per_sample(scene: &KernelScene) -> u64 {
 /// per node.
 pub fn hardware_loop_iterations_per_sample(scene: &KernelScene) -> u64 {
     sample_iterations(&scene.params, hardware_loop_iterations_per_ray(scene))
+        + grid_iterations(scene)
 }
 
 /// [`loop_iterations_per_ray`] for the hardware traversal (see

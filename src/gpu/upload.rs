@@ -126,6 +126,9 @@ pub struct SceneBuffers {
     clearcoat_energy: wgpu::Buffer,
     /// The wide tree's nodes and its uniform top, in the wide variant only.
     wide: Option<(wgpu::Buffer, wgpu::Buffer)>,
+    /// Grid media's descriptors and numbers (bindings 46 and 47), in kernels with grid media
+    /// only.
+    grids: Option<(wgpu::Buffer, wgpu::Buffer)>,
     pub texel_binding: TexelBinding,
 }
 
@@ -197,6 +200,12 @@ impl SceneBuffers {
             )
         });
         let features = &variant.features;
+        let grids = (features.media && features.grid_media).then(|| {
+            (
+                storage_buffer(ctx, "grid media", &scene.grids),
+                storage_buffer(ctx, "grid media voxels", &scene.grid_voxels),
+            )
+        });
         Ok(SceneBuffers {
             scene_type,
             spheres: scene_buffer(ctx, "spheres", &scene.spheres, usage),
@@ -266,6 +275,7 @@ impl SceneBuffers {
                 crate::tables::clearcoat::clearcoat_energy_table,
             ),
             wide,
+            grids,
             texel_binding,
         })
     }
@@ -347,6 +357,12 @@ impl SceneBuffers {
                     read_only,
                 ),
                 BufferNeed::new("lights", array_bytes(&scene.lights), read_only),
+                BufferNeed::new("grid media", array_bytes(&scene.grids), read_only),
+                BufferNeed::new(
+                    "grid media voxels",
+                    array_bytes(&scene.grid_voxels),
+                    read_only,
+                ),
                 BufferNeed::new("accumulation", images.accumulation, BufferBinding::Storage),
                 BufferNeed::new("readback", images.accumulation, BufferBinding::Unbound),
                 BufferNeed::new("aov_albedo_depth", images.aov, BufferBinding::Storage),
@@ -397,6 +413,10 @@ impl SceneBuffers {
         if let Some((nodes, top)) = &self.wide {
             bindings.push((44, READ_ONLY, nodes));
             bindings.push((45, UNIFORM, top));
+        }
+        if let Some((grids, voxels)) = &self.grids {
+            bindings.push((46, READ_ONLY, grids));
+            bindings.push((47, READ_ONLY, voxels));
         }
         if self.texel_binding.is_split() {
             bindings.extend(

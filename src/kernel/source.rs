@@ -162,6 +162,10 @@ pub const SHADER_PARTS: [(&str, &str); 46] = [
         include_str!("../../shaders/media/phase.wgsl"),
     ),
     (
+        "media/grid.wgsl",
+        include_str!("../../shaders/media/grid.wgsl"),
+    ),
+    (
         "media/medium.wgsl",
         include_str!("../../shaders/media/medium.wgsl"),
     ),
@@ -234,8 +238,9 @@ const SCENE_UNIFORM: &str = include_str!("../../shaders/core/scene_uniform.wgsl"
 /// The parts that only scenes with media need (`KernelFeatures::media`): behind a constant
 /// false, lavapipe still translated and inlined them for every kernel it built (about 0.2 s
 /// of CPU time and 45 MiB each)...
-const MEDIA_PARTS: [&str; 3] = [
+const MEDIA_PARTS: [&str; 4] = [
     "media/phase.wgsl",
+    "media/grid.wgsl",
     "media/medium.wgsl",
     "integrator/path_media.wgsl",
 ];
@@ -243,6 +248,13 @@ const MEDIA_PARTS: [&str; 3] = [
 const NO_MEDIA: (&str, &str) = (
     "media/no_media.wgsl",
     include_str!("../../shaders/media/no_media.wgsl"),
+);
+
+/// What stands in for media/grid.wgsl in kernels with media but no grid media: the tracking
+/// functions medium.wgsl calls, never reached (no medium has a grid).
+const NO_GRID_MEDIA: (&str, &str) = (
+    "media/no_grid.wgsl",
+    include_str!("../../shaders/media/no_grid.wgsl"),
 );
 
 /// Name of the compute entry point in `shaders/integrator/path.wgsl`.
@@ -329,7 +341,7 @@ fn features_part(features: &KernelFeatures) -> String {
          const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
          const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
          const HAS_TEXCOORD_1: bool = {};\nconst HAS_INSTANCES: bool = {};\n\
-         const HAS_MEDIA: bool = {};\n",
+         const HAS_MEDIA: bool = {};\nconst HAS_GRID_MEDIA: bool = {};\n",
         features.light_sampling,
         features.sphere_emitters,
         features.quad_emitters,
@@ -350,7 +362,8 @@ fn features_part(features: &KernelFeatures) -> String {
         features.vertex_colors,
         features.textures && features.texcoord1,
         features.instances,
-        features.media
+        features.media,
+        features.media && features.grid_media
     )
 }
 
@@ -408,7 +421,16 @@ pub fn render_kernel_source_with_texels(
     };
     for (i, &(name, text)) in SHADER_PARTS.iter().chain(bdpt_parts).enumerate() {
         // Without media, the stubs take the media's parts' place (medium.wgsl's).
-        let (name, text) = if variant.features.media || !MEDIA_PARTS.contains(&name) {
+        let (name, text) = if name == "media/grid.wgsl" {
+            if !variant.features.media {
+                continue;
+            }
+            if variant.features.grid_media {
+                (name, text)
+            } else {
+                NO_GRID_MEDIA
+            }
+        } else if variant.features.media || !MEDIA_PARTS.contains(&name) {
             (name, text)
         } else if name == "media/medium.wgsl" {
             NO_MEDIA

@@ -84,6 +84,8 @@ pub const NO_MEDIUM: u32 = u32::MAX;
 /// A homogeneous medium as the kernel reads it (`src/cpu/media/medium.rs`): extinction and
 /// scattering per unit length, Henyey–Greenstein's g, and the material whose objects bound it
 /// (their inside is this medium), or [`NO_MEDIUM`] for the global medium and a camera's.
+/// For a grid medium, `grid` indexes `KernelScene::grids` and the coefficients are per unit
+/// density; [`NO_GRID`] for a homogeneous one.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Medium {
@@ -91,6 +93,30 @@ pub struct Medium {
     pub g: f32,
     pub sigma_s: [f32; 3],
     pub boundary: u32,
+    pub grid: u32,
+    pub _pad: [u32; 3],
+}
+
+/// `Medium::grid`: a homogeneous medium.
+pub const NO_GRID: u32 = u32::MAX;
+
+/// A heterogeneous medium's density grid as the kernel reads it (`src/cpu/media/grid.rs`):
+/// the map from the scene to continuous grid coordinates (voxel i's centre at i + ½, the grid
+/// covering [0, dims]), as the rows of a 3 × 4 matrix; the dense densities, x fastest, from
+/// `voxels` in `KernelScene::grid_voxels`; and the majorants of blocks of `block` voxels a
+/// side, `blocks` of them along each axis, from `majorants` in the same array.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GridMedium {
+    pub to_grid_x: [f32; 4],
+    pub to_grid_y: [f32; 4],
+    pub to_grid_z: [f32; 4],
+    pub dims: [u32; 3],
+    pub voxels: u32,
+    pub blocks: [u32; 3],
+    pub majorants: u32,
+    pub block: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `Params::integrator`: unidirectional path tracing with next-event estimation.

@@ -229,6 +229,10 @@ pub struct KernelFeatures {
     /// Participating media (shaders/media/, shaders/integrator/path_media.wgsl): free flights,
     /// medium vertices, interfaces and shadow rays through them.
     pub media: bool,
+    /// Heterogeneous media's density grids (shaders/media/grid.wgsl): delta and ratio tracking
+    /// against a majorant grid. Without them (and in kernels without media) a stub stands in,
+    /// and homogeneous media keep their closed forms alone.
+    pub grid_media: bool,
     /// Bidirectional path tracing (shaders/integrator/bdpt/, shaders/lights/emission.wgsl,
     /// shaders/integrator/splat.wgsl) and its entry point, for scenes rendered with
     /// `Params::integrator` = `INTEGRATOR_BDPT`; compiled out of path tracing's kernels. Its
@@ -261,6 +265,7 @@ impl KernelFeatures {
         instances: true,
         texcoord1: true,
         media: true,
+        grid_media: true,
         bdpt: true,
     };
 
@@ -304,6 +309,7 @@ impl KernelFeatures {
             instances: !scene.instances.is_empty(),
             texcoord1: !scene.triangle_uvs1.is_empty(),
             media: scene.params.medium_count > 0,
+            grid_media: scene.params.medium_count > 0 && !scene.grids.is_empty(),
             bdpt,
         }
     }
@@ -333,6 +339,7 @@ impl KernelFeatures {
             instances: self.instances || other.instances,
             texcoord1: self.texcoord1 || other.texcoord1,
             media: self.media || other.media,
+            grid_media: self.grid_media || other.grid_media,
             bdpt: self.bdpt || other.bdpt,
         }
     }
@@ -361,6 +368,7 @@ impl KernelFeatures {
             && needs(self.instances, other.instances)
             && needs(self.texcoord1, other.texcoord1)
             && needs(self.media, other.media)
+            && needs(self.grid_media, other.grid_media)
             && needs(self.bdpt, other.bdpt)
     }
 }

@@ -113,6 +113,8 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         environment_alias,
         lights,
         instances,
+        grids,
+        grid_voxels,
     } = scene;
     let mut params = *params;
     params.sample_start = 0;
@@ -181,6 +183,11 @@ pub fn settings_hash(scene: &KernelScene) -> String {
             .map(|i| crate::kernel::types::Instance { blas_root: 0, ..*i })
             .collect();
         array("instances", bytemuck::cast_slice(&placed));
+    }
+    // Grid media's grids, where there are any.
+    if !grids.is_empty() {
+        array("grids", bytemuck::cast_slice(grids));
+        array("grid voxels", bytemuck::cast_slice(grid_voxels));
     }
     let mut hex = String::with_capacity(64);
     for byte in hasher.finalize() {

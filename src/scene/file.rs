@@ -67,6 +67,8 @@ pub(super) struct SceneToml {
     pub(super) lights: Vec<S<LightToml>>,
     #[serde(default)]
     pub(super) media: BTreeMap<String, S<MediumToml>>,
+    #[serde(default)]
+    pub(super) volumes: Vec<S<VolumeToml>>,
 }
 
 /// `[media.NAME]`: a homogeneous medium, as `sigma_a` and `sigma_s` or as `color` (the
@@ -81,6 +83,22 @@ pub(super) struct MediumToml {
     /// A number, or three (one per channel).
     pub(super) mean_free_path: Option<S<toml::Value>>,
     pub(super) g: Option<S<Real>>,
+    /// An OpenVDB file (relative to the scene file's folder) whose float grid scales the
+    /// coefficients (then per unit density): a heterogeneous medium, placed by `[[volumes]]`.
+    pub(super) grid: Option<S<String>>,
+    /// The grid's name in the file (default `"density"`).
+    pub(super) grid_name: Option<S<String>>,
+}
+
+/// `[[volumes]]`: a grid medium placed in the scene, inside an interface box around the
+/// grid's active values, moved by `translate`, `rotate` and `scale` as a mesh is.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct VolumeToml {
+    pub(super) medium: S<String>,
+    pub(super) translate: Option<S<Triple>>,
+    pub(super) rotate: Option<S<Triple>>,
+    pub(super) scale: Option<S<ScaleToml>>,
 }
 
 #[derive(Deserialize)]

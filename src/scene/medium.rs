@@ -3,7 +3,9 @@
 //! (`[render] medium`) or the camera's surroundings (`[camera] medium`). The kernel's side is
 //! `shaders/media/` (mirror: `src/cpu/media/`); docs/src/reference/media.md is the user's.
 
-use glam::Vec3;
+use super::grid::DensityGrid;
+use glam::{Mat4, Vec3};
+use std::sync::Arc;
 
 /// The most medium slots the kernel holds (`Params::media`): one per object material that
 /// bounds a medium, one for the global medium, one for the camera's where no object bounds it.
@@ -13,7 +15,8 @@ pub const MAX_MEDIUM_SLOTS: usize = 8;
 /// shortest length glint supports, so σ·t never overflows f32 inside the coordinate range.
 pub const MAX_COEFFICIENT: f32 = 1e8;
 
-/// One homogeneous medium: coefficients per unit length, per RGB channel.
+/// One medium: coefficients per unit length, per RGB channel (per unit length and unit
+/// density for a grid medium).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Medium {
     pub name: String,
@@ -21,6 +24,17 @@ pub struct Medium {
     pub sigma_s: Vec3,
     /// Henyey–Greenstein's mean cosine, in (−1, 1): > 0 scatters forwards.
     pub g: f32,
+    /// A heterogeneous medium's density grid (`[media.NAME] grid`), and once a `[[volumes]]`
+    /// entry places it, where: `None` for a homogeneous medium.
+    pub grid: Option<GridMedium>,
+}
+
+/// A density grid, and the transform from the grid's own space to the scene's (identity
+/// until a volume places it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridMedium {
+    pub grid: Arc<DensityGrid>,
+    pub placement: Mat4,
 }
 
 /// The scene's media and where they are.

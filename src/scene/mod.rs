@@ -9,6 +9,7 @@
 
 pub mod environment;
 mod file;
+pub mod grid;
 pub mod image;
 pub mod light;
 pub mod limits;

@@ -117,8 +117,11 @@ fn shipped_scenes() -> Vec<(String, String)> {
         // Mesh scenes name files relative to their folder (and stress.toml one that is
         // generated), so a mutant parsed from text alone could never be valid, and loading a
         // mesh per case would cost seconds: tests/suite/mesh_errors.rs covers bad meshes instead.
-        // Image textures are files too (tests/suite/textures.rs covers bad ones).
-        .filter(|(_, text)| !text.contains("[[meshes]]") && !text.contains("texture ="))
+        // Image textures are files too (tests/suite/textures.rs covers bad ones), and so are
+        // density grids (tests/suite/grid_media.rs covers bad ones).
+        .filter(|(_, text)| {
+            !text.contains("[[meshes]]") && !text.contains("texture =") && !text.contains("grid =")
+        })
         .collect();
     scenes.sort();
     assert!(scenes.len() >= 5, "the shipped scenes are missing");

@@ -9,8 +9,8 @@ use glint::kernel::source::{
 };
 use glint::kernel::texels::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use glint::kernel::types::{
-    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, Instance, Light, Material,
-    Medium, Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals,
+    BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, GridMedium, Instance, Light,
+    Material, Medium, Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals,
     TriangleTangents, TriangleUvs,
 };
 use glint::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding, SceneCounts};
@@ -129,7 +129,18 @@ fn rust_structs_match_wgsl_layout() {
             media
         ]
     );
-    assert_same_layout!(&module, Medium, "Medium", [sigma_t, g, sigma_s, boundary]);
+    assert_same_layout!(
+        &module,
+        Medium,
+        "Medium",
+        [sigma_t, g, sigma_s, boundary, grid]
+    );
+    assert_same_layout!(
+        &module,
+        GridMedium,
+        "GridMedium",
+        [to_grid_x, to_grid_y, to_grid_z, dims, voxels, blocks, majorants, block]
+    );
     assert_same_layout!(
         &module,
         Sphere,
@@ -459,6 +470,32 @@ fn kernels_without_media_carry_only_the_media_stubs() {
     }
     assert!(without.contains("// ---- media/no_media.wgsl"));
     assert!(!with.contains("// ---- media/no_media.wgsl"));
+    assert!(!without.contains("// ---- media/no_grid.wgsl"));
+}
+
+/// Kernels of scenes whose media are all homogeneous carry the grid stub, not the tracking.
+#[test]
+fn kernels_without_grid_media_carry_only_the_grid_stub() {
+    let source = |grid_media| {
+        render_kernel_source_for(KernelVariant {
+            binding: SceneBinding::Storage,
+            features: KernelFeatures {
+                grid_media,
+                ..KernelFeatures::ALL
+            },
+        })
+    };
+    let (with, without) = (source(true), source(false));
+    for part in [
+        "// ---- media/grid.wgsl",
+        "fn block_walk(",
+        "var<storage, read> grid_voxels",
+    ] {
+        assert!(with.contains(part), "{part} missing with grid media");
+        assert!(!without.contains(part), "{part} present without grid media");
+    }
+    assert!(without.contains("// ---- media/no_grid.wgsl"));
+    assert!(!with.contains("// ---- media/no_grid.wgsl"));
 }
 
 /// Every combination of compiled-out features gives a valid kernel, in every binding.
@@ -504,6 +541,8 @@ fn every_feature_combination_validates() {
             instances: (bits * 17 / 11) % 2 == 1,
             // Likewise, with and without light sampling, lights and dielectrics.
             media: (bits * 19 / 13) % 2 == 1,
+            // Likewise, with and without media (without them it is compiled out either way).
+            grid_media: (bits * 29 / 19) % 2 == 1,
             // Likewise, with and without lights, the environment, textures and triangles.
             bdpt: (bits * 23 / 17) % 2 == 1,
         };
@@ -554,6 +593,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         texcoord1: false,
         instances: false,
         media: false,
+        grid_media: false,
         bdpt: false,
     };
     for features in [KernelFeatures::ALL, none] {

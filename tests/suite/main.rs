@@ -53,6 +53,7 @@ mod chi2;
 mod closed_form;
 mod environment;
 mod gpu_vs_cpu;
+mod grid_media;
 mod lights;
 mod media;
 mod sampling;

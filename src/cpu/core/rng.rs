@@ -17,6 +17,8 @@ pub const PURPOSE_ROULETTE: u32 = 2;
 pub const PURPOSE_FREE_FLIGHT: u32 = 3;
 pub const PURPOSE_PHASE: u32 = 4;
 pub const PURPOSE_MEDIUM_LIGHT: u32 = 5;
+/// Ratio tracking through grid media along a vertex's shadow ray (`src/cpu/media/grid.rs`).
+pub const PURPOSE_TRACKING: u32 = 6;
 
 /// `Params::sampler`: independent uniform numbers (a PCG stream per sample).
 pub const SAMPLER_INDEPENDENT: u32 = 0;

@@ -16,7 +16,7 @@ use crate::cpu::lights::punctual::sun_disks_radiance;
 use crate::cpu::lights::sampling::{light_pdf, light_visible, sample_light};
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample, is_delta};
 use crate::cpu::media::medium::{
-    is_interface, medium_crossed, medium_start, shadow_transmittance, MediumStack,
+    is_interface, medium_crossed, medium_start, shadow_transmittance, MediumStack, TrackingStream,
 };
 use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::normal_map::normal_mapped;
@@ -350,7 +350,12 @@ fn add_unblocked_light<const MEDIA: bool>(
         if light.dir.dot(hit.normal) < 0.0 {
             media = medium_crossed(params, &media, hit.material, hit.front_face);
         }
-        through = shadow_transmittance(shadow_scene, &shadow, light, &media, segments);
+        let tracking = TrackingStream {
+            pixel,
+            sample,
+            bounce,
+        };
+        through = shadow_transmittance(shadow_scene, &shadow, light, &media, segments, tracking);
         if !through.cmpgt(Vec3::ZERO).any() {
             return;
         }

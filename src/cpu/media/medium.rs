@@ -15,14 +15,16 @@
 //! Georgiev and Jarosz 2019), so chromatic media are unbiased in every channel.
 
 use crate::cpu::core::ray::Ray;
+use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_TRACKING};
 use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::geometry::intersect::intersect_scene;
 use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::lights::light_sample::LightSample;
+use crate::cpu::media::grid::grid_transmittance;
 use crate::cpu::scene_refs::SceneRefs;
 use crate::kernel::types::{
-    Material, Medium, Params, LIGHT_SUN, MATERIAL_DIELECTRIC, NO_MEDIUM, PRIMITIVE_ENVIRONMENT,
-    PRIMITIVE_LIGHT,
+    Material, Medium, Params, LIGHT_SUN, MATERIAL_DIELECTRIC, NO_GRID, NO_MEDIUM,
+    PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT,
 };
 use glam::Vec3;
 
@@ -121,6 +123,47 @@ pub fn transmittance(sigma_t: Vec3, d: f32) -> Vec3 {
     Vec3::new(channel(sigma_t.x), channel(sigma_t.y), channel(sigma_t.z))
 }
 
+/// Where a shadow ray's ratio tracking draws from: the stream `PURPOSE_TRACKING` of the
+/// vertex at `bounce` of the path of (`pixel`, `sample`).
+#[derive(Clone, Copy, Debug)]
+pub struct TrackingStream {
+    pub pixel: u32,
+    pub sample: u32,
+    pub bounce: u32,
+}
+
+/// The transmittance of medium slot `slot` ([`NO_MEDIUM`]: none) along `ray` from 0 to `t`:
+/// Beer's law in a homogeneous medium, ratio tracking in a grid medium (from `rng`, made from
+/// `tracking` when first needed).
+pub fn segment_transmittance(
+    scene: &SceneRefs,
+    slot: u32,
+    ray: &Ray,
+    t: f32,
+    tracking: TrackingStream,
+    rng: &mut Option<Rng>,
+) -> Vec3 {
+    if slot == NO_MEDIUM {
+        return Vec3::ONE;
+    }
+    let params = scene.params;
+    let m = &params.media[slot as usize];
+    if m.grid != NO_GRID {
+        let rng = rng.get_or_insert_with(|| {
+            let stream = stream_id(tracking.bounce, PURPOSE_TRACKING);
+            Rng::with_sampler(
+                tracking.pixel,
+                tracking.sample,
+                stream,
+                params.seed,
+                params.sampler,
+            )
+        });
+        return grid_transmittance(scene.grids, m, ray, t, rng);
+    }
+    transmittance(Vec3::from(m.sigma_t), t)
+}
+
 /// A free flight: where it ended, and the factor the path's throughput takes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FreeFlight {
@@ -168,15 +211,19 @@ pub fn sample_free_flight(m: &Medium, t_max: f32, u_channel: f32, u_distance: f3
 /// The transmittance from the shadow ray's origin (in the media of `stack`) to the sampled
 /// light: Beer's law over each segment, through interfaces, which change the medium as a path
 /// crossing them would; zero where anything else blocks it. `scene` carries the shadow ray's
-/// alpha key. Counts the rays it casts in `segments`.
+/// alpha key. Counts the rays it casts in `segments`. Grid media's segments are ratio
+/// tracked, drawing from the `tracking` vertex's `PURPOSE_TRACKING` stream (made at the first
+/// grid segment: homogeneous media need no random numbers here).
 pub fn shadow_transmittance(
     scene: &SceneRefs,
     shadow: &Ray,
     light: &LightSample,
     stack: &MediumStack,
     segments: &mut u32,
+    tracking: TrackingStream,
 ) -> Vec3 {
     let params = scene.params;
+    let mut rng = None;
     let mut ray = *shadow;
     let mut media = *stack;
     let mut through = Vec3::ONE;
@@ -207,18 +254,13 @@ pub fn shadow_transmittance(
             t_light = hit.t;
         }
         let slot = current_medium(params, &media);
-        let sigma_t = if slot == NO_MEDIUM {
-            Vec3::ZERO
-        } else {
-            Vec3::from(params.media[slot as usize].sigma_t)
-        };
         if t_light >= 0.0 {
-            return through * transmittance(sigma_t, t_light);
+            return through * segment_transmittance(scene, slot, &ray, t_light, tracking, &mut rng);
         }
         if hit.t == NO_HIT || !is_interface(&scene.materials[hit.material as usize]) {
             return Vec3::ZERO;
         }
-        through *= transmittance(sigma_t, hit.t);
+        through *= segment_transmittance(scene, slot, &ray, hit.t, tracking, &mut rng);
         media = medium_crossed(params, &media, hit.material, hit.front_face);
         ray = Ray {
             origin: offset_ray_origin(hit.position, hit.error, -hit.normal),

@@ -6,6 +6,7 @@
 mod acceleration;
 mod emitter_table;
 mod geometry;
+mod grids;
 mod materials;
 mod params;
 
@@ -61,6 +62,10 @@ pub struct KernelScene {
     /// scene's own in `triangles` and whose bottom-level BVHs follow the top level in
     /// `bvh_nodes`; empty without instances.
     pub instances: Vec<types::Instance>,
+    /// Grid media's descriptors (`Medium::grid` indexes them) and, in one array, each grid's
+    /// densities and block majorants (`grids.rs`); empty without grid media.
+    pub grids: Vec<types::GridMedium>,
+    pub grid_voxels: Vec<f32>,
 }
 
 impl KernelScene {
@@ -88,6 +93,8 @@ impl KernelScene {
             + bytes(&self.environment_alias)
             + bytes(&self.lights)
             + bytes(&self.instances)
+            + bytes(&self.grids)
+            + bytes(&self.grid_voxels)
     }
 }
 
@@ -157,6 +164,7 @@ impl Scene {
             Some((_, tables)) => (tables.texels, tables.alias),
             None => (Vec::new(), Vec::new()),
         };
+        let (grids, grid_voxels) = grids::kernel_grids(&self.media);
         let mut scene = KernelScene {
             params,
             spheres: geometry::kernel_spheres(self, &sphere_probability),
@@ -188,6 +196,8 @@ impl Scene {
                 .map(|(l, p)| l.kernel_light(p))
                 .collect(),
             instances: Vec::new(),
+            grids,
+            grid_voxels,
         };
         scene.params.splat_scale = params::splat_scale(&scene);
         self.lay_out_bvh(&mut scene)?;

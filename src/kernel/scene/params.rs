@@ -37,6 +37,25 @@ pub fn place_camera(params: &mut Params, camera: &Camera) {
     params.focus_distance = camera.focus_distance;
 }
 
+/// The grid media the kernel holds, in `KernelScene::grids` order: those that volumes placed
+/// (each bounds its own box), in the order of the boundaries.
+pub(super) fn placed_grids(media: &crate::scene::medium::Media) -> Vec<u32> {
+    media
+        .boundaries
+        .iter()
+        .map(|&(_, medium)| medium)
+        .filter(|&m| media.list[m as usize].grid.is_some())
+        .collect()
+}
+
+/// The index in `KernelScene::grids` of `medium`'s grid, or `NO_GRID`.
+fn grid_index(media: &crate::scene::medium::Media, medium: u32) -> u32 {
+    placed_grids(media)
+        .iter()
+        .position(|&m| m == medium)
+        .map_or(crate::kernel::types::NO_GRID, |i| i as u32)
+}
+
 impl Scene {
     /// The media's slots (validation keeps them within `MAX_MEDIUM_SLOTS`): one per material
     /// that bounds a medium, then the global medium and the camera's where no object bounds
@@ -54,6 +73,9 @@ impl Scene {
                 g: m.g,
                 sigma_s: m.sigma_s.into(),
                 boundary,
+                // Grid media are numbered in the order of the list (`grid_arrays`).
+                grid: grid_index(media, medium),
+                _pad: [0; 3],
             };
             count += 1;
             count as u32 - 1

@@ -2,13 +2,16 @@
 //! name (`medium = "NAME"` on `[render]`, `[camera]`, spheres and meshes).
 
 use super::super::file::{MaterialToml, MediumToml, Real, Triple, S};
+use super::super::grid::read_density_grid;
 use super::super::limits::{MAX_COORDINATE, MIN_LENGTH};
-use super::super::medium::{Medium, MAX_COEFFICIENT};
+use super::super::medium::{GridMedium, Medium, MAX_COEFFICIENT};
 use super::super::MaterialKind;
 use super::fields::{fail, real, vec3, FieldError};
 use super::materials::Materials;
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::Arc;
 
 /// The scene's media, and their indices by name.
 pub(super) struct MediaNames {
@@ -38,17 +41,70 @@ impl MediaNames {
     }
 }
 
-/// The `[media]` tables, in name order.
+impl MediaNames {
+    /// The index of the homogeneous medium `m` names, for an object, the scene or the camera
+    /// to be filled with: a grid medium is placed by `[[volumes]]` only.
+    pub(super) fn homogeneous(&self, m: &S<String>, field: &str) -> Result<u32, FieldError> {
+        let index = self.reference(m, field)?;
+        if self.list[index as usize].grid.is_some() {
+            return fail(
+                m.span(),
+                field,
+                format!(
+                    "medium {:?} has a density grid, which a [[volumes]] entry places (its \
+                     grid fills a box around its active voxels); only homogeneous media fill \
+                     objects, the scene or the camera's surroundings",
+                    m.get_ref()
+                ),
+            );
+        }
+        Ok(index)
+    }
+}
+
+/// The `[media]` tables, in name order; grid files are read relative to `folder`.
 pub(super) fn validate_media(
     toml: &BTreeMap<String, S<MediumToml>>,
+    folder: &Path,
 ) -> Result<MediaNames, FieldError> {
     let mut list = Vec::new();
     let mut index_of = BTreeMap::new();
     for (name, m) in toml {
         index_of.insert(name.clone(), list.len() as u32);
-        list.push(validate_medium(name, m)?);
+        let mut medium = validate_medium(name, m)?;
+        medium.grid = medium_grid(name, m.get_ref(), folder)?;
+        list.push(medium);
     }
     Ok(MediaNames { list, index_of })
+}
+
+/// `grid` and `grid_name`: the density grid, read, or `None` for a homogeneous medium.
+fn medium_grid(
+    name: &str,
+    m: &MediumToml,
+    folder: &Path,
+) -> Result<Option<GridMedium>, FieldError> {
+    let Some(file) = &m.grid else {
+        if let Some(g) = &m.grid_name {
+            return fail(
+                g.span(),
+                format!("media.{name}.grid_name"),
+                "grid_name names a grid of the file that grid gives: give grid as well",
+            );
+        }
+        return Ok(None);
+    };
+    let grid_name = m.grid_name.as_ref().map_or("density", |g| g.get_ref());
+    let path = folder.join(file.get_ref());
+    let grid = read_density_grid(&path, grid_name).map_err(|message| FieldError {
+        span: Some(file.span()),
+        field: format!("media.{name}.grid"),
+        message,
+    })?;
+    Ok(Some(GridMedium {
+        grid: Arc::new(grid),
+        placement: Mat4::IDENTITY,
+    }))
 }
 
 /// `[media.NAME]`: exactly one of the two forms, every coefficient ≥ 0 and finite, |g| < 1.
@@ -151,6 +207,7 @@ fn validate_medium(name: &str, m: &S<MediumToml>) -> Result<Medium, FieldError> 
         sigma_a,
         sigma_s,
         g,
+        grid: None,
     })
 }
 
@@ -270,6 +327,7 @@ pub(super) fn subsurface_media(
             sigma_a,
             sigma_s,
             g: 0.0,
+            grid: None,
         });
         filled.insert(material, media.list.len() as u32 - 1);
     }

@@ -57,19 +57,19 @@ impl SceneToml {
 
         let settings = validate_render(&render, render_span)?;
         let mut materials = materials::validate_materials(&self.materials, folder)?;
-        let mut media = media::validate_media(&self.media)?;
+        let mut media = media::validate_media(&self.media, folder)?;
         let subsurface = media::subsurface_media(&self.materials, &mut materials, &mut media)?;
         let global = render
             .medium
             .as_ref()
-            .map(|m| media.reference(m, "render.medium"))
+            .map(|m| media.homogeneous(m, "render.medium"))
             .transpose()?;
         let camera_medium = camera_toml_medium
             .as_ref()
-            .map(|m| media.reference(m, "camera.medium"))
+            .map(|m| media.homogeneous(m, "camera.medium"))
             .transpose()?
             .filter(|&m| Some(m) != global);
-        let objects = objects::validate_objects(
+        let mut objects = objects::validate_objects(
             &self.spheres,
             &self.quads,
             &self.meshes,
@@ -78,6 +78,7 @@ impl SceneToml {
             &media,
             &subsurface,
         )?;
+        objects::place_volumes(&self.volumes, &mut objects, &mut materials, &mut media)?;
         if objects.boundaries.len() + 2 > MAX_MEDIUM_SLOTS {
             return Err(whole(
                 "media",

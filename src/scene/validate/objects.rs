@@ -1,10 +1,12 @@
 //! `[[spheres]]`, `[[quads]]` and `[[meshes]]`: the scene's geometry.
 
-use super::super::file::{MeshToml, QuadToml, ScaleToml, SphereToml, S};
+use super::super::file::{MeshToml, QuadToml, ScaleToml, SphereToml, Triple, VolumeToml, S};
 use super::super::light::Light;
 use super::super::limits::{MIN_LENGTH, MIN_SINE};
 use super::super::mesh::{self, MeshTransform};
-use super::super::{AlphaMode, InstancedMesh, Material, Quad, Sphere, Triangle};
+use super::super::{
+    Alpha, AlphaMode, InstancedMesh, Material, MaterialKind, Quad, Sphere, Triangle,
+};
 use super::fields::{coordinates, fail, length_in_range, real, sine_between, vec3, FieldError};
 use super::materials::Materials;
 use super::media::MediaNames;
@@ -90,7 +92,7 @@ pub(super) fn validate_objects(
         let mut sphere = validate_sphere(s.get_ref(), i, materials)?;
         // An explicit medium, else the one a subsurface material implies.
         let medium = match &s.get_ref().medium {
-            Some(m) => Some(media.reference(m, &format!("spheres[{i}].medium"))?),
+            Some(m) => Some(media.homogeneous(m, &format!("spheres[{i}].medium"))?),
             None => subsurface.get(&sphere.material).copied(),
         };
         if let Some(medium) = medium {
@@ -124,7 +126,7 @@ pub(super) fn validate_objects(
     for (i, m) in meshes_toml.iter().enumerate() {
         let medium = match (&m.get_ref().medium, &m.get_ref().material) {
             (Some(name), _) => Some((
-                media.reference(name, &format!("meshes[{i}].medium"))?,
+                media.homogeneous(name, &format!("meshes[{i}].medium"))?,
                 name,
                 "medium",
             )),
@@ -391,6 +393,21 @@ fn mesh_transform(
     m: &MeshToml,
     field: &dyn Fn(&str) -> String,
 ) -> Result<MeshTransform, FieldError> {
+    transform(&m.translate, &m.rotate, &m.scale, field)
+}
+
+/// `translate`, `rotate` (degrees) and `scale` (each factor > 0), of a mesh or a volume.
+fn transform(
+    translate: &Option<S<Triple>>,
+    rotate: &Option<S<Triple>>,
+    scale: &Option<S<ScaleToml>>,
+    field: &dyn Fn(&str) -> String,
+) -> Result<MeshTransform, FieldError> {
+    let m = TransformFields {
+        translate,
+        rotate,
+        scale,
+    };
     let translate = match &m.translate {
         Some(t) => coordinates(t, &field("translate"))?,
         None => Vec3::ZERO,
@@ -414,6 +431,101 @@ fn mesh_transform(
         rotate_degrees: rotate,
         translate,
     })
+}
+
+struct TransformFields<'a> {
+    translate: &'a Option<S<Triple>>,
+    rotate: &'a Option<S<Triple>>,
+    scale: &'a Option<S<ScaleToml>>,
+}
+
+/// `[[volumes]]`: each places a grid medium. The medium is copied with the volume's placement
+/// (each volume its own medium slot, as its grid lies elsewhere), and an interface box around
+/// the grid's padded active box, made of 12 triangles in a material of its own, bounds it.
+pub(super) fn place_volumes(
+    volumes: &[S<VolumeToml>],
+    objects: &mut Objects,
+    materials: &mut Materials,
+    media: &mut MediaNames,
+) -> Result<(), FieldError> {
+    for (i, v) in volumes.iter().enumerate() {
+        let field = |f: &str| format!("volumes[{i}].{f}");
+        let v = v.get_ref();
+        let index = media.reference(&v.medium, &field("medium"))?;
+        let mut medium = media.list[index as usize].clone();
+        let Some(grid) = &mut medium.grid else {
+            return fail(
+                v.medium.span(),
+                field("medium"),
+                format!(
+                    "medium {:?} has no density grid: a volume places a grid medium (give it \
+                     grid = \"file.vdb\"); a homogeneous medium fills a sphere or a closed mesh",
+                    v.medium.get_ref()
+                ),
+            );
+        };
+        grid.placement = transform(&v.translate, &v.rotate, &v.scale, &field)?.matrix();
+        let corners = grid.grid.corners(&grid.placement);
+        if corners
+            .iter()
+            .any(|c| !c.is_finite() || c.abs().max_element() > super::super::limits::MAX_COORDINATE)
+        {
+            return fail(
+                v.medium.span(),
+                field("medium"),
+                "the volume's box lies beyond the coordinates glint supports: scale or move it",
+            );
+        }
+        medium.name = format!("{} (volumes[{i}])", medium.name);
+        media.list.push(medium);
+        let medium = media.list.len() as u32 - 1;
+        materials.list.push(Material::untextured(
+            format!("volumes[{i}] (interface)"),
+            MaterialKind::Dielectric { ior: 1.0 },
+            Vec3::ONE,
+            Vec3::ZERO,
+            Alpha::OPAQUE,
+        ));
+        let material = materials.list.len() as u32 - 1;
+        objects.triangles.extend(box_triangles(&corners, material));
+        objects.boundaries.push((material, medium));
+    }
+    Ok(())
+}
+
+/// The 12 triangles of the box with these corners (corner c at bit 0: +x, bit 1: +y, bit 2:
+/// +z), wound so that their normals point out of the box.
+fn box_triangles(corners: &[Vec3; 8], material: u32) -> Vec<Triangle> {
+    const FACES: [[usize; 4]; 6] = [
+        [0, 1, 3, 2],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 3, 7, 5],
+    ];
+    let centre = corners.iter().copied().sum::<Vec3>() / 8.0;
+    let mut out = Vec::with_capacity(12);
+    for [a, b, c, d] in FACES {
+        for [p, q, r] in [[a, b, c], [a, c, d]] {
+            let mut vertices = [corners[p], corners[q], corners[r]];
+            let normal = (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
+            let middle = (vertices[0] + vertices[1] + vertices[2]) / 3.0;
+            if normal.dot(middle - centre) < 0.0 {
+                vertices.swap(1, 2);
+            }
+            out.push(Triangle {
+                vertices,
+                normals: None,
+                material,
+                uvs: None,
+                uvs1: None,
+                tangents: None,
+                colors: None,
+            });
+        }
+    }
+    out
 }
 
 /// A scale factor per axis, each finite and > 0 (a mesh's `scale` or an instance's).

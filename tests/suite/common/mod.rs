@@ -4,6 +4,7 @@
 pub mod chi2;
 pub mod merge_bound;
 pub mod probe;
+pub mod vdb;
 
 use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::gpu::{GpuContext, GpuRenderer};
