@@ -7,7 +7,7 @@ use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 46] = [
+pub const SHADER_PARTS: [(&str, &str); 47] = [
     (
         "core/types.wgsl",
         include_str!("../../shaders/core/types.wgsl"),
