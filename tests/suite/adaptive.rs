@@ -17,10 +17,7 @@ use glint::render::partial::{Partial, FORMAT, FORMAT_COUNTS};
 use glint::render::{render_progressive, BatchSizer, Renderer, StopReason, StopRules};
 use glint::scene::{RenderOverrides, Scene};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 use std::time::Duration;
-
-const GLINT: &str = env!("CARGO_BIN_EXE_glint");
 
 /// A diffuse sphere lit by a small lamp in the middle of a 24×16 image, the rest of which sees
 /// the constant background (0.5): those pixels' samples are all exactly 0.5, so their variance
@@ -261,20 +258,6 @@ fn scene_file(dir: &Path) -> PathBuf {
     path
 }
 
-fn glint(dir: &Path, args: &[&str]) -> Output {
-    let out = Command::new(GLINT)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run glint");
-    assert!(
-        out.status.success(),
-        "glint {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
 fn read(path: &Path) -> Partial {
     Partial::read(path).unwrap()
 }
@@ -292,7 +275,7 @@ fn an_adaptive_render_resumes_to_the_single_render() {
     let run = |out: &str, more: &[&str]| {
         let mut args = vec!["render", scene, "-o", out];
         args.extend_from_slice(more);
-        glint(dir.path(), &args)
+        common::glint_ok(dir.path(), &args)
     };
     run("single.exr", &[&ADAPTIVE[..], &["--spp", "256"]].concat());
     run("part.exr", &[&ADAPTIVE[..], &["--spp", "64"]].concat());
@@ -336,16 +319,16 @@ fn adaptive_shards_merge_pixel_by_pixel() {
     ];
     for shard in ["0/2", "1/2"] {
         let out = format!("s{}.exr", &shard[..1]);
-        glint(
+        common::glint_ok(
             dir.path(),
             &[&["render", scene, "-o", &out, "--shard", shard][..], &tight].concat(),
         );
     }
-    glint(
+    common::glint_ok(
         dir.path(),
         &["merge", "s0.exr", "s1.exr", "-o", "merged.exr"],
     );
-    glint(
+    common::glint_ok(
         dir.path(),
         &["render", scene, "-o", "plain.exr", "--cpu", "--spp", "256"],
     );

@@ -12,14 +12,14 @@
 use crate::common;
 use glint::cpu::integrator::renderer::CpuRenderer;
 use glint::image::output::Image;
-use glint::kernel::types::{INTEGRATOR_BDPT, INTEGRATOR_PATH};
+use glint::kernel::types::INTEGRATOR_PATH;
 use glint::kernel::KernelScene;
 use glint::render::batch_means::BatchMeans;
 use glint::render::partial::Partial;
 use glint::render::{relative_error, Renderer};
 use serde_json::Value;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
 /// The bound on |z| of every test here, as statistics.rs and bdpt.rs use.
 const MAX_Z: f64 = 4.0;
@@ -31,23 +31,6 @@ const SEEDS: u32 = 128;
 const WEIGHT_SEEDS: u32 = 16;
 const SPP: u32 = 64;
 const SIZE: u32 = 8;
-
-/// The Cornell box all diffuse (the mirror sphere matte) with a larger light, two bounces:
-/// light tracing's splats carry much of the light, and no sample is a firefly.
-fn diffuse_box(size: u32, seed: u32) -> KernelScene {
-    let text = common::shipped_scene_text("cornell.toml")
-        .replace("type = \"specular\"", "type = \"diffuse\"")
-        .replace(
-            "corner = [343.0, 554.0, 332.0]",
-            "corner = [443.0, 554.0, 432.0]",
-        )
-        .replace("u = [-130.0, 0.0, 0.0]", "u = [-330.0, 0.0, 0.0]")
-        .replace("v = [0.0, 0.0, -105.0]", "v = [0.0, 0.0, -305.0]");
-    let mut scene = common::sized(common::scene(&text), size, seed);
-    scene.params.integrator = INTEGRATOR_BDPT;
-    scene.params.max_bounces = 2;
-    scene
-}
 
 /// One render's mean, its batch-means variance and its camera strategies' own variance.
 fn render(scene: &KernelScene, spp: u32) -> (Image, Image, Image) {
@@ -113,7 +96,7 @@ fn spread_ratio(means: &[Image], variances: &[Image], weights: &[f64]) -> (f64, 
 fn batch_means_predict_the_spread_of_independent_renders() {
     let (mut means, mut batch, mut own) = (Vec::new(), Vec::new(), Vec::new());
     for seed in 0..SEEDS {
-        let (mean, variance, camera) = render(&diffuse_box(SIZE, 100 + seed), SPP);
+        let (mean, variance, camera) = render(&common::bdpt_diffuse_box(SIZE, 100 + seed), SPP);
         means.push(mean);
         batch.push(variance);
         own.push(camera);
@@ -122,7 +105,7 @@ fn batch_means_predict_the_spread_of_independent_renders() {
     // channel counts about as much as another, not as much as its variance.
     let mut reference = vec![0.0f64; (SIZE * SIZE * 3) as usize];
     for seed in 0..WEIGHT_SEEDS {
-        let (_, variance, _) = render(&diffuse_box(SIZE, 1000 + seed), SPP);
+        let (_, variance, _) = render(&common::bdpt_diffuse_box(SIZE, 1000 + seed), SPP);
         for (p, v) in reference.iter_mut().enumerate() {
             *v += variance.pixels[p / 3][p % 3] as f64 / WEIGHT_SEEDS as f64;
         }
@@ -176,7 +159,7 @@ fn batch_means_predict_the_spread_of_independent_renders() {
 #[test]
 fn without_splats_batch_means_estimate_the_samples_own_variance() {
     let path = |seed| {
-        let mut scene = diffuse_box(64, seed);
+        let mut scene = common::bdpt_diffuse_box(64, seed);
         scene.params.integrator = INTEGRATOR_PATH;
         scene
     };
@@ -210,20 +193,6 @@ fn without_splats_batch_means_estimate_the_samples_own_variance() {
 }
 
 const GLINT: &str = env!("CARGO_BIN_EXE_glint");
-
-fn glint(dir: &Path, args: &[&str]) -> Output {
-    let out = Command::new(GLINT)
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run glint");
-    assert!(
-        out.status.success(),
-        "glint {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
 
 /// `glint render` of the glass Cornell box, bidirectional, small, on the CPU.
 fn render_args<'a>(more: &[&'a str]) -> Vec<&'a str> {
@@ -268,7 +237,7 @@ fn variance_file(path: &Path) -> Image {
 fn bdpt_variance_is_written_resumed_and_merged() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    glint(
+    common::glint_ok(
         d,
         &render_args(&[
             "--spp",
@@ -286,8 +255,8 @@ fn bdpt_variance_is_written_resumed_and_merged() {
     assert!(variance.mean() > 0.0);
 
     // Resumed: 64, then on to 128.
-    glint(d, &render_args(&["--spp", "64", "-o", "resumed.exr"]));
-    glint(
+    common::glint_ok(d, &render_args(&["--spp", "64", "-o", "resumed.exr"]));
+    common::glint_ok(
         d,
         &render_args(&[
             "--spp",
@@ -307,12 +276,12 @@ fn bdpt_variance_is_written_resumed_and_merged() {
     // Shards 0..64 and 64..128, merged.
     for shard in ["0/2", "1/2"] {
         let out = format!("part-{}.exr", &shard[..1]);
-        glint(
+        common::glint_ok(
             d,
             &render_args(&["--spp", "128", "--shard", shard, "-o", &out]),
         );
     }
-    glint(
+    common::glint_ok(
         d,
         &[
             "merge",
@@ -345,7 +314,7 @@ fn bdpt_variance_is_written_resumed_and_merged() {
 fn target_error_stops_a_bdpt_render() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let out = glint(
+    let out = common::glint_ok(
         d,
         &render_args(&[
             "--spp",

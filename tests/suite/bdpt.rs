@@ -190,27 +190,10 @@ fn image_mean(image: &Image) -> f64 {
         / (3 * image.pixels.len()) as f64
 }
 
-/// The Cornell box all diffuse (the mirror sphere matte: a delta vertex would rule strategies
-/// out), with a larger light (so that BSDF sampling finds it often enough to test).
-fn diffuse_box(seed: u32) -> KernelScene {
-    let text = common::shipped_scene_text("cornell.toml")
-        .replace("type = \"specular\"", "type = \"diffuse\"")
-        .replace(
-            "corner = [343.0, 554.0, 332.0]",
-            "corner = [443.0, 554.0, 432.0]",
-        )
-        .replace("u = [-130.0, 0.0, 0.0]", "u = [-330.0, 0.0, 0.0]")
-        .replace("v = [0.0, 0.0, -105.0]", "v = [0.0, 0.0, -305.0]");
-    let mut scene = common::sized(common::scene(&text), 8, seed);
-    scene.params.integrator = INTEGRATOR_BDPT;
-    scene.params.max_bounces = 2;
-    scene
-}
-
 /// The image mean of `estimate` over `BATCHES` seeds, and its standard error.
 fn mean_and_error(estimate: impl Fn(&KernelScene) -> f64) -> (f64, f64) {
     let values: Vec<f64> = (0..BATCHES)
-        .map(|b| estimate(&diffuse_box(b + 1)))
+        .map(|b| estimate(&common::bdpt_diffuse_box(8, b + 1)))
         .collect();
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;
@@ -266,7 +249,7 @@ fn each_strategy_alone_estimates_the_same_light() {
             "strategy ({s}, {}) alone: {alone:?} against path tracing's {path_two_scatterings:?}",
             4 - s
         );
-        let scene = diffuse_box(1);
+        let scene = common::bdpt_diffuse_box(8, 1);
         weighted_sum += image_mean(&strategy_image(
             &scene,
             spp,
@@ -276,7 +259,7 @@ fn each_strategy_alone_estimates_the_same_light() {
             },
         ));
     }
-    let scene = diffuse_box(1);
+    let scene = common::bdpt_diffuse_box(8, 1);
     let mut one_bounce = scene.clone();
     one_bounce.params.max_bounces = 1;
     render_two_scatterings += image_mean(&strategy_image(&scene, spp, all))

@@ -13,6 +13,7 @@ use glint::kernel::KernelScene;
 use glint::render::{render_image, Renderer};
 use glint::scene::Scene;
 use std::path::Path;
+use std::process::Output;
 use std::sync::OnceLock;
 
 /// The test GPU: a Vulkan adapter (lavapipe in CI). A missing device fails the test, so a
@@ -326,3 +327,37 @@ max_bounces = 4
 type = "diffuse"
 color = [0.5, 0.5, 0.5]
 "#;
+
+/// `glint ARGS` run in `dir`, which must succeed (its stderr in the failure message).
+pub fn glint_ok(dir: &Path, args: &[&str]) -> Output {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_glint"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run glint");
+    assert!(
+        out.status.success(),
+        "glint {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// The Cornell box all diffuse (the mirror sphere matte: a delta vertex would rule strategies
+/// out) with a larger light (so that BSDF sampling finds it often enough to test), rendered
+/// bidirectionally with two bounces, at `size`² and `seed`: light tracing's splats carry much
+/// of the light, and no sample is a firefly.
+pub fn bdpt_diffuse_box(size: u32, seed: u32) -> KernelScene {
+    let text = shipped_scene_text("cornell.toml")
+        .replace("type = \"specular\"", "type = \"diffuse\"")
+        .replace(
+            "corner = [343.0, 554.0, 332.0]",
+            "corner = [443.0, 554.0, 432.0]",
+        )
+        .replace("u = [-130.0, 0.0, 0.0]", "u = [-330.0, 0.0, 0.0]")
+        .replace("v = [0.0, 0.0, -105.0]", "v = [0.0, 0.0, -305.0]");
+    let mut scene = sized(self::scene(&text), size, seed);
+    scene.params.integrator = glint::kernel::types::INTEGRATOR_BDPT;
+    scene.params.max_bounces = 2;
+    scene
+}
