@@ -306,6 +306,13 @@ impl<'a> GpuRenderer<'a> {
         &self.images.mean
     }
 
+    /// The splat film the kernel adds bidirectional path tracing's light tracing to, and its
+    /// fixed-point scale (`Params::splat_scale`); `None` for path tracing.
+    pub fn splat_film(&self) -> Option<(&wgpu::Buffer, f32)> {
+        let splats = self.images.splats.as_ref().filter(|_| self.is_bdpt())?;
+        Some((&splats.film, self.params.splat_scale))
+    }
+
     /// Where the kernel reads the scene from.
     pub fn scene_binding(&self) -> SceneBinding {
         self.variant.binding

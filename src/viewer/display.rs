@@ -1,4 +1,5 @@
-//! The display pass: shows a renderer's running mean (or the denoised image) on a surface,
+//! The display pass: shows a renderer's running mean (with bidirectional path tracing's splat
+//! film added where there is one), or the denoised image, on a surface,
 //! through the tone curve (`shaders/viewer/display.wgsl`, `shaders/viewer/tonemap.wgsl`). It reads the mean
 //! buffer where the kernel wrote it, so showing a frame costs no readback.
 
@@ -24,7 +25,9 @@ pub struct DisplayUniform {
     pub encode_srgb: u32,
     /// [`tonemap_code`] of the curve.
     pub tonemap: u32,
-    pub pad: u32,
+    /// 1 / (splat scale × samples per pixel): what a unit of the splat film's sums adds to the
+    /// mean; 0 where nothing splats.
+    pub splat_weight: f32,
 }
 
 /// The shader's code for `tonemap` (`TONEMAP_*` in shaders/viewer/tonemap.wgsl).
@@ -61,6 +64,11 @@ impl DisplayPass {
                 ),
                 buffer_layout_entry(
                     1,
+                    wgpu::BufferBindingType::Storage { read_only: true },
+                    wgpu::ShaderStages::FRAGMENT,
+                ),
+                buffer_layout_entry(
+                    2,
                     wgpu::BufferBindingType::Storage { read_only: true },
                     wgpu::ShaderStages::FRAGMENT,
                 ),
@@ -112,9 +120,16 @@ impl DisplayPass {
         }
     }
 
-    /// Shows `mean` (per pixel vec4s of linear radiance) from now on: call it whenever the
-    /// renderer (and so its buffer) changes, or to switch between the raw and denoised images.
-    pub fn bind(&mut self, device: &wgpu::Device, mean: &wgpu::Buffer) {
+    /// Shows `mean` (per pixel vec4s of linear radiance), plus `splats` (a splat film) where
+    /// given, from now on: call it whenever the renderer (and so its buffers) changes, or to
+    /// switch between the raw and denoised images. Without a film the mean is bound in its
+    /// place, unread ([`DisplayPass::draw`]'s `splat_weight` is then 0).
+    pub fn bind(
+        &mut self,
+        device: &wgpu::Device,
+        mean: &wgpu::Buffer,
+        splats: Option<&wgpu::Buffer>,
+    ) {
         self.bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("display"),
             layout: &self.layout,
@@ -127,12 +142,18 @@ impl DisplayPass {
                     binding: 1,
                     resource: mean.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: splats.unwrap_or(mean).as_entire_binding(),
+                },
             ],
         }));
     }
 
-    /// Records the pass: the bound image of `image_size`, shown through `transform` (as a PNG
-    /// would hold it), drawn over all of `target` (of `target_size`).
+    /// Records the pass: the bound image of `image_size`, its splat sums weighted by
+    /// `splat_weight` (see [`DisplayUniform::splat_weight`]), shown through `transform` (as a
+    /// PNG would hold it), drawn over all of `target` (of `target_size`).
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
         queue: &wgpu::Queue,
@@ -141,6 +162,7 @@ impl DisplayPass {
         image_size: (u32, u32),
         target_size: (u32, u32),
         transform: &DisplayTransform,
+        splat_weight: f32,
     ) {
         let Some(bind_group) = &self.bind_group else {
             return;
@@ -151,7 +173,7 @@ impl DisplayPass {
             scale: transform.exposure.exp2(),
             encode_srgb: self.encode_srgb as u32,
             tonemap: tonemap_code(transform.tonemap),
-            pad: 0,
+            splat_weight,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -1,7 +1,8 @@
 //! The viewer's display pass: naga validates shaders/viewer/display.wgsl (with tonemap.wgsl), the Rust
 //! uniform matches the WGSL struct, and on the GPU the pass shows mean × 2^exposure through each
 //! tone curve, sRGB-encoded, the bytes a PNG of the same mean holds (±1), for sRGB and plain
-//! surface formats (src/image/tonemap.rs is the CPU side).
+//! surface formats (src/image/tonemap.rs is the CPU side); with a splat film bound, the mean plus
+//! the fixed-point sums times the splat weight.
 
 use crate::common;
 use glint::image::output::srgb_byte;
@@ -72,7 +73,10 @@ fn display_uniform_matches_wgsl_layout() {
             offset_of!(DisplayUniform, encode_srgb) as u32,
         ),
         ("tonemap".into(), offset_of!(DisplayUniform, tonemap) as u32),
-        ("pad".into(), offset_of!(DisplayUniform, pad) as u32),
+        (
+            "splat_weight".into(),
+            offset_of!(DisplayUniform, splat_weight) as u32,
+        ),
     ];
     assert_eq!(rust, wgsl);
     assert_eq!(size_of::<DisplayUniform>() as u32, layouter[handle].size);
@@ -84,7 +88,26 @@ fn draw(
     mean: &[[f32; 4]],
     transform: &DisplayTransform,
 ) -> Vec<[u8; 4]> {
+    draw_with_splats(format, mean, None, transform)
+}
+
+/// [`draw`], with a splat film (per pixel and channel a u64 as two u32 words) and its weight.
+fn draw_with_splats(
+    format: wgpu::TextureFormat,
+    mean: &[[f32; 4]],
+    splats: Option<(&[u64], f32)>,
+    transform: &DisplayTransform,
+) -> Vec<[u8; 4]> {
     let ctx = common::gpu().unwrap();
+    let splat_buffer = splats.map(|(sums, _)| {
+        ctx.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: None,
+                contents: bytemuck::cast_slice(sums),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+    });
+    let splat_weight = splats.map_or(0.0, |(_, weight)| weight);
     let (w, h) = (4u32, 2u32);
     let mean_buffer = ctx
         .device
@@ -115,10 +138,18 @@ fn draw(
         mapped_at_creation: false,
     });
     let mut pass = DisplayPass::new(&ctx.device, format);
-    pass.bind(&ctx.device, &mean_buffer);
+    pass.bind(&ctx.device, &mean_buffer, splat_buffer.as_ref());
     let view = texture.create_view(&Default::default());
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    pass.draw(&ctx.queue, &mut encoder, &view, (w, h), (w, h), transform);
+    pass.draw(
+        &ctx.queue,
+        &mut encoder,
+        &view,
+        (w, h),
+        (w, h),
+        transform,
+        splat_weight,
+    );
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
@@ -207,4 +238,54 @@ fn display_pass_shows_what_a_png_holds() {
             }
         }
     }
+}
+
+#[test]
+fn display_pass_adds_the_splat_film() {
+    if common::gpu().is_none() {
+        return;
+    }
+    // Sums above 2^32 exercise the high word; a weight of 2^-33 keeps them in [0, 1].
+    let mean: Vec<[f32; 4]> = (0..8).map(|i| [0.05 * i as f32, 0.1, 0.0, 0.0]).collect();
+    let sums: Vec<u64> = (0..24u64).map(|k| k * (1u64 << 29) + 12345).collect();
+    let weight = 2f32.powi(-33);
+    let transform = DisplayTransform {
+        tonemap: Tonemap::Clamp,
+        exposure: 0.0,
+    };
+    let expected: Vec<[u8; 3]> = mean
+        .iter()
+        .enumerate()
+        .map(|(pixel, m)| {
+            std::array::from_fn(|c| {
+                let splat = sums[3 * pixel + c] as f64 * weight as f64;
+                srgb_byte((m[c] as f64 + splat) as f32)
+            })
+        })
+        .collect();
+    let got = draw_with_splats(
+        wgpu::TextureFormat::Rgba8Unorm,
+        &mean,
+        Some((&sums, weight)),
+        &transform,
+    );
+    for (i, (g, e)) in got.iter().zip(&expected).enumerate() {
+        for c in 0..3 {
+            assert!(
+                (g[c] as i32 - e[c] as i32).abs() <= 1,
+                "pixel {i}: got {g:?}, mean plus splats is {e:?}"
+            );
+        }
+    }
+    // A zero weight leaves the mean alone.
+    let plain = draw_with_splats(
+        wgpu::TextureFormat::Rgba8Unorm,
+        &mean,
+        Some((&sums, 0.0)),
+        &transform,
+    );
+    assert_eq!(
+        plain,
+        draw(wgpu::TextureFormat::Rgba8Unorm, &mean, &transform)
+    );
 }
