@@ -36,6 +36,8 @@ pub enum Action {
     SaveExr,
     /// Turn denoising of the shown image on or off (D).
     Denoise,
+    /// Switch between path tracing and bidirectional path tracing (I).
+    SwitchIntegrator,
     /// Re-read the scene file now.
     Reload,
     /// Ask the window system for a new inner size (tests: the same path as a user resize).
@@ -138,6 +140,7 @@ fn parse_action(command: &str) -> Result<Action, String> {
         "reload" => Action::Reload,
         "wait-edit" => Action::WaitForEdit,
         "denoise" => Action::Denoise,
+        "integrator" => Action::SwitchIntegrator,
         "wait-denoised" => Action::WaitForDenoise,
         "quit" => Action::Quit,
         _ => return Err(format!("unknown action {name:?}")),
@@ -160,8 +163,14 @@ mod tests {
         assert_eq!(s.take(10), vec![Action::Reload]);
         assert_eq!(s.take(12), vec![Action::Quit]);
         assert_eq!(
-            Script::parse("0:denoise; 0:wait-denoised").unwrap().take(0),
-            vec![Action::Denoise, Action::WaitForDenoise]
+            Script::parse("0:denoise; 0:wait-denoised; 0:integrator")
+                .unwrap()
+                .take(0),
+            vec![
+                Action::Denoise,
+                Action::WaitForDenoise,
+                Action::SwitchIntegrator
+            ]
         );
         assert_eq!(
             Script::parse("1:fly 0 0 0.5; 2:resize 64 32; 3:exposure -1")

@@ -120,6 +120,7 @@ impl InputState {
                 "p" | "P" if !repeat => Some(Action::SavePng),
                 "x" | "X" if !repeat => Some(Action::SaveExr),
                 "d" | "D" if !repeat => Some(Action::Denoise),
+                "i" | "I" if !repeat => Some(Action::SwitchIntegrator),
                 _ => None,
             },
             _ => None,

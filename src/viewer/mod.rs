@@ -86,12 +86,6 @@ pub fn run(options: ViewOptions) -> Result<()> {
         ))
         .into());
     }
-    if scene.render.integrator == crate::scene::Integrator::Bdpt {
-        crate::errln!(
-            "glint view: note: {} asks for the bdpt integrator; the viewer previews it with path tracing (glint render renders it bidirectionally)",
-            options.scene.display()
-        );
-    }
     // Built once here (the BVH, the environment map's tables), and again only when the scene
     // file changes; a camera move rewrites the camera's parameters alone.
     let kernel = scene.try_kernel_scene()?;

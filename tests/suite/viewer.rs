@@ -2,7 +2,8 @@
 //! program must be installed), on the Vulkan device: the Cornell box's walls in the screenshot;
 //! camera moves, R and resizes restart the accumulation and exposure does not; a scene edit is
 //! reloaded and a broken one keeps the last good scene; no display is exit code 2; D denoises
-//! (or says why not, once); PNG screenshots follow --tonemap/--exposure; memory stays flat. The
+//! (or says why not, once); I switches to bidirectional path tracing and what it saves is what
+//! `glint render --integrator bdpt` writes; PNG screenshots follow --tonemap/--exposure; memory stays flat. The
 //! hidden --script and --log-frames flags drive it and report each frame and event as JSON.
 
 use serde_json::Value;
@@ -217,6 +218,82 @@ fn cornell_screenshot_shows_the_green_and_red_walls() {
     let right = mean_rgb(&png, RIGHT_WALL, WALL_ROWS);
     assert!(left[1] > 1.5 * left[0], "left wall is green: {left:?}");
     assert!(right[0] > 1.5 * right[1], "right wall is red: {right:?}");
+}
+
+#[test]
+fn i_switches_to_bdpt_and_the_viewer_holds_what_render_writes() {
+    let Some(session) = Session::start() else {
+        return;
+    };
+    // Path tracing for frames 0 and 1, then I: frame 2 restarts bidirectionally (a 1-spp
+    // preview), and frames 3-5 add 4 spp each, 13 in all.
+    let log = Session::log_of(&mut session.view_cornell(
+        32,
+        32,
+        &[
+            "--spp-per-frame",
+            "4",
+            "--frames",
+            "6",
+            "--script",
+            "2:integrator",
+            "--screenshot",
+            "shot.exr",
+        ],
+    ));
+    let switched = events(&log, "integrator");
+    assert_eq!(switched.len(), 1, "{switched:?}");
+    assert_eq!(switched[0]["integrator"], "bdpt");
+    assert!(switched[0].get("error").is_none(), "{switched:?}");
+    let spp: Vec<u64> = frames(&log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect();
+    assert_eq!(spp, [1, 5, 1, 5, 9, 13]);
+    let titles = events(&log, "title");
+    assert!(
+        titles
+            .iter()
+            .any(|t| t["title"].as_str().unwrap().contains("· bdpt")),
+        "the title names the integrator: {titles:?}"
+    );
+
+    // The same samples through `glint render`: sample numbers depend only on the pixel, the
+    // sample index and the seed, and the splat film's sums are exact, so the two agree to
+    // rounding (the viewer accumulates in other batches). The light-tracing strategies carry a
+    // large share of the box's radiance here; without the splat film the mean falls by it.
+    let rendered = session.path().join("render.exr");
+    let out = Command::new(GLINT)
+        .args(["render", scene_path("cornell.toml").to_str().unwrap()])
+        .args([
+            "--gpu",
+            "--integrator",
+            "bdpt",
+            "--width",
+            "32",
+            "--height",
+            "32",
+        ])
+        .args(["--spp", "13", "-o", rendered.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let viewed = glint::image::output::Image::read_exr(&session.path().join("shot.exr")).unwrap();
+    let rendered = glint::image::output::Image::read_exr(&rendered).unwrap();
+    let mut largest = 0.0f32;
+    for (v, r) in viewed.pixels.iter().zip(&rendered.pixels) {
+        for c in 0..3 {
+            largest = largest.max((v[c] - r[c]).abs() / r[c].abs().max(1e-3));
+        }
+    }
+    assert!(
+        largest < 1e-3,
+        "viewer against render: relative difference {largest}"
+    );
 }
 
 #[test]

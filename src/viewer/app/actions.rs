@@ -4,8 +4,9 @@ use super::state::*;
 use super::surface::upload_denoised;
 use crate::image::format::ImageFormat;
 use crate::image::output::Image;
+use crate::kernel::KernelScene;
 use crate::render::Renderer;
-use crate::scene::{Camera, RenderOverrides};
+use crate::scene::{Camera, Integrator, RenderOverrides, Scene};
 use crate::viewer::action::Action;
 use crate::viewer::camera_control;
 use crate::viewer::denoised::{Snapshot, Update};
@@ -48,6 +49,7 @@ impl App {
                     (self.display.exposure + stops).clamp(-EXPOSURE_LIMIT, EXPOSURE_LIMIT);
             }
             Action::Denoise => self.toggle_denoise()?,
+            Action::SwitchIntegrator => self.switch_integrator()?,
             Action::WaitForDenoise => {
                 let update = self.denoised.wait(self.snapshot(), WAIT_FOR_EDIT_LIMIT);
                 self.take_denoised(update);
@@ -135,6 +137,7 @@ impl App {
                     self.file_camera = scene.camera.clone();
                     self.camera = scene.camera.clone();
                 }
+                let (scene, kernel) = self.keep_integrator(scene, kernel);
                 self.scene = scene;
                 self.kernel = kernel;
                 self.rebuild_renderer()?;
@@ -146,6 +149,53 @@ impl App {
             }
         }
         Ok(())
+    }
+
+    /// A reloaded scene, rendered by the integrator switched to unless the file's own changed;
+    /// where the switched-to one cannot render the new scene (bdpt and a medium), the file's.
+    fn keep_integrator(&mut self, scene: Scene, kernel: KernelScene) -> (Scene, KernelScene) {
+        let from_file = scene.render.integrator;
+        if from_file != self.file_integrator {
+            self.file_integrator = from_file;
+            self.integrator = from_file;
+            return (scene, kernel);
+        }
+        match App::with_integrator(scene.clone(), kernel.clone(), self.integrator) {
+            Ok(switched) => switched,
+            Err(e) => {
+                self.refuse_integrator(self.integrator, &e);
+                self.integrator = from_file;
+                (scene, kernel)
+            }
+        }
+    }
+
+    /// Switches between path tracing and bidirectional path tracing (I), restarting the
+    /// accumulation; a scene the other cannot render keeps its integrator, and says why.
+    pub(super) fn switch_integrator(&mut self) -> Result<()> {
+        let wanted = match self.integrator {
+            Integrator::Path => Integrator::Bdpt,
+            Integrator::Bdpt => Integrator::Path,
+        };
+        match App::with_integrator(self.scene.clone(), self.kernel.clone(), wanted) {
+            Ok((scene, kernel)) => {
+                self.scene = scene;
+                self.kernel = kernel;
+                self.integrator = wanted;
+                self.integrator_note = None;
+                self.rebuild_renderer()?;
+                self.log(json!({"event": "integrator", "integrator": wanted.name(), "frame": self.frame}));
+            }
+            Err(e) => self.refuse_integrator(wanted, &e),
+        }
+        self.title.since -= TITLE_INTERVAL;
+        Ok(())
+    }
+
+    fn refuse_integrator(&mut self, wanted: Integrator, why: &str) {
+        crate::errln!("glint view: cannot switch to {}: {why}", wanted.name());
+        self.integrator_note = Some(format!("no {}, see stderr", wanted.name()));
+        self.log(json!({"event": "integrator", "integrator": self.integrator.name(), "frame": self.frame, "error": why}));
     }
 
     /// PNG: what is shown (the mean, or with D on the denoised image of all samples so far,

@@ -4,7 +4,7 @@ use super::state::*;
 use super::surface::{present, show_denoised};
 use crate::image::tonemap::Tonemap;
 use crate::render::Renderer;
-use crate::scene::{RenderOverrides, MAX_SPP};
+use crate::scene::{Integrator, RenderOverrides, MAX_SPP};
 use crate::viewer::denoised::Snapshot;
 use anyhow::{anyhow, Result};
 use serde_json::json;
@@ -129,13 +129,16 @@ impl App {
         if self.display.tonemap != Tonemap::Clamp {
             title += &format!(" · {:?}", self.display.tonemap).to_lowercase();
         }
+        if self.integrator != Integrator::Path {
+            title += &format!(" · {}", self.integrator.name());
+        }
         if self.denoised.is_on() {
             title += " · denoised";
             if let Some(shown) = self.denoised.shown() {
                 title += &format!(" ({} spp)", shown.spp);
             }
         }
-        for note in [&self.scene_error, &self.denoise_note]
+        for note in [&self.scene_error, &self.denoise_note, &self.integrator_note]
             .into_iter()
             .flatten()
         {

@@ -1,13 +1,13 @@
 //! The viewer's state: the scene, the camera, the renderer and the window, and the steps
 //! that open, rebuild and close them.
 
-use super::surface::{pick_format, Gpu};
+use super::surface::{bind_renderer, pick_format, Gpu};
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::image::tonemap::DisplayTransform;
 use crate::kernel::types::Params;
 use crate::kernel::{place_camera, KernelScene};
 use crate::render::BatchSizer;
-use crate::scene::{Camera, Scene, MAX_IMAGE_PIXELS};
+use crate::scene::{Camera, Integrator, RenderOverrides, Scene, MAX_IMAGE_PIXELS};
 use crate::viewer::action::Script;
 use crate::viewer::denoised::DenoisedView;
 use crate::viewer::display::DisplayPass;
@@ -41,6 +41,11 @@ pub(super) struct App {
     pub(super) file_camera: Camera,
     pub(super) camera: Camera,
     pub(super) camera_moved: bool,
+    /// The integrator the scene file says; like the camera, a reload adopts it only if it
+    /// changed, so an edit keeps the integrator I switched to.
+    pub(super) file_integrator: Integrator,
+    /// The integrator the window shows (I switches it live).
+    pub(super) integrator: Integrator,
     /// The accumulation restarted: the next frame is a 1-spp preview.
     pub(super) restarted: bool,
     /// The tone curve and the exposure (which + and - change).
@@ -53,6 +58,8 @@ pub(super) struct App {
     pub(super) generation: u64,
     /// Why D cannot denoise, for the title, once it was pressed without OIDN.
     pub(super) denoise_note: Option<String>,
+    /// Why I cannot switch to the other integrator, for the title, after a refused switch.
+    pub(super) integrator_note: Option<String>,
     pub(super) sizer: BatchSizer,
     pub(super) input: InputState,
     pub(super) watch: FileWatch,
@@ -112,10 +119,6 @@ impl App {
         let mut params = self.kernel.params;
         place_camera(&mut params, &self.camera);
         params.aovs = self.aovs as u32;
-        // The window shows the kernel's mean buffer as it runs, and bidirectional path tracing
-        // keeps its light tracing in a splat film beside it: the viewer previews with path
-        // tracing, the same image in expectation (`run` says so).
-        params.integrator = crate::kernel::types::INTEGRATOR_PATH;
         params
     }
 
@@ -177,9 +180,13 @@ impl App {
         let traversal = self.options.traversal.resolve(ctx)?;
         let renderer = GpuRenderer::with_traversal(ctx, &kernel_scene, traversal)?;
         let mut display = DisplayPass::new(&ctx.device, format);
-        display.bind(&ctx.device, renderer.mean_buffer());
+        display.bind(
+            &ctx.device,
+            renderer.mean_buffer(),
+            renderer.splat_film().map(|(film, _)| film),
+        );
         crate::errln!(
-            "glint view: {} on {} ({:?}, {:?}); drag to orbit, right-drag to pan, wheel to dolly, arrow keys and Q/E to fly, D to denoise",
+            "glint view: {} on {} ({:?}, {:?}); drag to orbit, right-drag to pan, wheel to dolly, arrow keys and Q/E to fly, D to denoise, I to switch path/bdpt",
             self.options.scene.display(),
             ctx.device_name(),
             format,
@@ -210,12 +217,29 @@ impl App {
         // The same traversal as before: the device has not changed.
         let traversal = gpu.renderer.traversal();
         gpu.renderer = GpuRenderer::with_traversal(gpu.ctx, &kernel_scene, traversal)?;
-        gpu.display
-            .bind(&gpu.ctx.device, gpu.renderer.mean_buffer());
+        bind_renderer(gpu);
         gpu.showing_denoised = false;
         self.camera_moved = false;
         self.restarted = true;
         Ok(())
+    }
+
+    /// `scene` and `kernel` rendered by `integrator`: the scene's own checks decide whether it
+    /// can (bdpt traces no media and a bounded number of bounces).
+    pub(super) fn with_integrator(
+        scene: Scene,
+        mut kernel: KernelScene,
+        integrator: Integrator,
+    ) -> Result<(Scene, KernelScene), String> {
+        if scene.render.integrator == integrator {
+            return Ok((scene, kernel));
+        }
+        let scene = scene.with_overrides(&RenderOverrides {
+            integrator: Some(integrator),
+            ..Default::default()
+        })?;
+        kernel.params.integrator = integrator.kernel_value();
+        Ok((scene, kernel))
     }
 
     /// Writes the screenshot, if asked for, and ends the event loop; once.

@@ -3,6 +3,7 @@
 use crate::gpu::{GpuContext, GpuRenderer};
 use crate::image::output::Image;
 use crate::image::tonemap::DisplayTransform;
+use crate::render::Renderer;
 use crate::viewer::display::DisplayPass;
 use anyhow::{anyhow, Context, Result};
 use std::sync::Arc;
@@ -37,12 +38,29 @@ pub(super) fn show_denoised(gpu: &mut Gpu, denoised: bool) {
     if denoised == gpu.showing_denoised {
         return;
     }
-    let buffer = match (&gpu.denoised_buffer, denoised) {
-        (Some(buffer), true) => buffer,
-        _ => gpu.renderer.mean_buffer(),
-    };
-    gpu.display.bind(&gpu.ctx.device, buffer);
+    match (&gpu.denoised_buffer, denoised) {
+        (Some(buffer), true) => gpu.display.bind(&gpu.ctx.device, buffer, None),
+        _ => bind_renderer(gpu),
+    }
     gpu.showing_denoised = denoised && gpu.denoised_buffer.is_some();
+}
+
+/// Binds the renderer's running mean, and its splat film if it has one, to the display pass.
+pub(super) fn bind_renderer(gpu: &mut Gpu) {
+    let splats = gpu.renderer.splat_film().map(|(film, _)| film);
+    gpu.display
+        .bind(&gpu.ctx.device, gpu.renderer.mean_buffer(), splats);
+}
+
+/// What one unit of the shown splat film adds to the mean (0 when none is shown): the sums
+/// over the splat scale and the samples per pixel, as `Accumulation::mean_image` adds them.
+fn splat_weight(gpu: &Gpu) -> f32 {
+    match gpu.renderer.splat_film() {
+        Some((_, scale)) if !gpu.showing_denoised && gpu.renderer.samples() > 0 => {
+            (1.0 / (scale as f64 * gpu.renderer.samples() as f64)) as f32
+        }
+        _ => 0.0,
+    }
 }
 
 /// Copies a denoised image to the GPU for the display pass.
@@ -127,6 +145,7 @@ pub(super) fn draw(
         image_size,
         (gpu.config.width, gpu.config.height),
         display,
+        splat_weight(gpu),
     );
     gpu.ctx.queue.submit([encoder.finish()]);
     gpu.window.pre_present_notify();
