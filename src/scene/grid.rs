@@ -78,6 +78,14 @@ impl DensityGrid {
     }
 
     /// The corners of the box in the scene, under `placement`.
+    /// Whether `p` lies strictly inside the box [`DensityGrid::corners`] spans.
+    pub fn box_contains(&self, placement: &Mat4, p: Vec3) -> bool {
+        let to_grid = (*placement * self.grid_to_object).inverse();
+        let q = to_grid.transform_point3(p);
+        let d = Vec3::from(self.dims.map(|d| d as f32));
+        q.is_finite() && q.cmpgt(Vec3::ZERO).all() && q.cmplt(d).all()
+    }
+
     pub fn corners(&self, placement: &Mat4) -> [Vec3; 8] {
         let d = Vec3::from(self.dims.map(|d| d as f32));
         std::array::from_fn(|c| {

@@ -34,11 +34,26 @@ fn parse_in(dir: &Path, toml: &str) -> Result<Scene, String> {
 
 /// A scene with a camera looking at the origin from −z, a sun and a grey sky, and `more`.
 fn scene_text(more: &str, size: u32, spp: u32, seed: u32) -> String {
+    scene_text_from([0.0, 0.4, -4.0], "", more, size, spp, seed)
+}
+
+/// [`scene_text`] with the camera's eye at `eye`, looking along +z, and `camera` added to its
+/// table.
+fn scene_text_from(
+    eye: [f32; 3],
+    camera: &str,
+    more: &str,
+    size: u32,
+    spp: u32,
+    seed: u32,
+) -> String {
+    let target = [eye[0], eye[1] - 0.1, eye[2] + 1.0];
     format!(
         r#"
 [camera]
-eye = [0.0, 0.4, -4.0]
-target = [0.0, 0.0, 0.0]
+{camera}
+eye = {eye:?}
+target = {target:?}
 up = [0.0, 1.0, 0.0]
 vfov = 40
 [render]
@@ -257,19 +272,50 @@ fn box_obj(lo: f32, hi: f32) -> String {
 /// another seed, so the two means are independent.
 #[test]
 fn a_constant_grid_renders_as_the_homogeneous_medium() {
+    constant_grid_against_homogeneous([0.0, 0.4, -4.0], &["cpu", "gpu"]);
+}
+
+/// The same with the camera inside the volume's box: the camera starts in the grid medium
+/// (found from the eye, as no scene file can name a volume's medium), as a camera inside the
+/// homogeneous box declared with `[camera] medium` does. Without that the view would be clear
+/// until rays left the box and met it again. The CPU only: the kernel starts in
+/// `Params::camera_medium` the same way whichever medium that is (media.rs tests it).
+#[test]
+fn a_camera_inside_a_volume_starts_in_its_medium() {
+    constant_grid_against_homogeneous([0.15, 0.1, -0.4], &["cpu"]);
+}
+
+/// Z-tests of the image mean per channel: the constant grid seen from `eye`, on `devices`,
+/// against the homogeneous box; the standard errors are from each render's per-pixel
+/// variance of the mean (pixels are independent: var of the image mean is Σ var / n²).
+fn constant_grid_against_homogeneous(eye: [f32; 3], devices: &[&str]) {
     let dir = tempfile::tempdir().unwrap();
     let mut grid = VdbGrid::float("density", [8, 8, 8], |_, _, _| 2.0);
     grid.translation = [-3.5; 3];
     let coefficients = "sigma_a = [0.1, 0.25, 0.05]\nsigma_s = [0.6, 0.3, 0.9]\ng = 0.3";
-    let spp = 256;
-    let scene = grid_scene(dir.path(), &grid, coefficients, 0.25, 16, spp, 1);
+    let (size, spp) = (16, 256);
+    std::fs::write(
+        dir.path().join("grid.vdb"),
+        write_vdb(std::slice::from_ref(&grid)),
+    )
+    .unwrap();
+    let volume = format!(
+        "[media.smoke]\ngrid = \"grid.vdb\"\n{coefficients}\n[[volumes]]\nmedium = \"smoke\"\n\
+         scale = 0.25\nrotate = [0.0, 20.0, 0.0]\n"
+    );
+    let scene = parse_in(dir.path(), &scene_text_from(eye, "", &volume, size, spp, 1))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .kernel_scene();
     std::fs::write(dir.path().join("box.obj"), box_obj(-1.0, 1.0)).unwrap();
+    let inside = eye.iter().all(|c| c.abs() < 0.9);
+    let camera_medium = if inside { "medium = \"fog\"" } else { "" };
     let homogeneous = "[materials.boundary]\ntype = \"interface\"\n[media.fog]\n\
          sigma_a = [0.2, 0.5, 0.1]\nsigma_s = [1.2, 0.6, 1.8]\ng = 0.3\n\
          [[meshes]]\nfile = \"box.obj\"\nmaterial = \"boundary\"\nmedium = \"fog\"\n\
          rotate = [0.0, 20.0, 0.0]\n";
-    let reference = parse_in(dir.path(), &scene_text(homogeneous, 16, spp, 2))
-        .unwrap()
+    let reference_text = scene_text_from(eye, camera_medium, homogeneous, size, spp, 2);
+    let reference = parse_in(dir.path(), &reference_text)
+        .unwrap_or_else(|e| panic!("{e}"))
         .kernel_scene();
     let mut cpu = glint::cpu::integrator::renderer::CpuRenderer::new(&reference);
     let (want, want_variance) = render_with_variance(&mut cpu, spp);
@@ -280,7 +326,14 @@ fn a_constant_grid_renders_as_the_homogeneous_medium() {
     let var = |image: &glint::image::output::Image, c: usize| {
         image.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / (n * n)
     };
-    for (device, mut renderer) in renderers(&scene) {
+    let mut under_test: Vec<(&str, Box<dyn glint::render::Renderer>)> = vec![(
+        "cpu",
+        Box::new(glint::cpu::integrator::renderer::CpuRenderer::new(&scene)),
+    )];
+    if devices.contains(&"gpu") {
+        under_test.extend(renderers(&scene).into_iter().filter(|(d, _)| *d == "gpu"));
+    }
+    for (device, mut renderer) in under_test {
         let (image, variance) = render_with_variance(renderer.as_mut(), spp);
         for c in 0..3 {
             let (a, b) = (mean(&image, c), mean(&want, c));
@@ -323,7 +376,7 @@ fn gpu_and_cpu_trace_the_same_paths_through_a_grid() {
 /// The refusals, each naming the field and the file: a missing file, one that is not a VDB,
 /// an OpenVDB stream without grid offsets, a vector grid, a grid name the file lacks, negative and non-finite densities, a grid too
 /// large for one GPU binding, a grid medium filling a sphere, a volume of a homogeneous
-/// medium, and every truncation of a valid file (an error, never a panic); a half-float grid
+/// medium, a camera inside two volumes (or one and a declared medium), and every truncation of a valid file (an error, never a panic); a half-float grid
 /// reads.
 #[test]
 fn bad_grids_are_refused_with_named_errors() {
@@ -397,6 +450,35 @@ fn bad_grids_are_refused_with_named_errors() {
     );
     std::fs::write(path.join("nan.vdb"), write_vdb(&[nan])).unwrap();
     refuse("nan.vdb", "", &["not finite", "nan.vdb"]);
+    // A camera starts in one medium: not inside two volumes' boxes, nor inside one and a
+    // declared medium. (The 4³ grid's box moved over the eye at [0, 0.4, −4].)
+    std::fs::write(
+        path.join("small.vdb"),
+        write_vdb(&[VdbGrid::float("density", [4, 4, 4], |_, _, _| 1.0)]),
+    )
+    .unwrap();
+    let over_eye = "[[volumes]]\nmedium = \"smoke\"\ntranslate = [-2.0, -1.6, -6.0]\n";
+    let two = format!(
+        "[media.smoke]\ngrid = \"small.vdb\"\nsigma_s = [1.0, 1.0, 1.0]\n{over_eye}{over_eye}"
+    );
+    let e = parse_in(path, &scene_text(&two, 8, 1, 1)).unwrap_err();
+    assert!(
+        e.contains("camera.eye") && e.contains("smoke (volumes[0]) and smoke (volumes[1])"),
+        "{e}"
+    );
+    let declared = format!(
+        "[media.fog]\nsigma_s = [0.1, 0.1, 0.1]\n[media.smoke]\ngrid = \"small.vdb\"\n\
+         sigma_s = [1.0, 1.0, 1.0]\n{over_eye}"
+    );
+    let e = parse_in(
+        path,
+        &scene_text_from([0.0, 0.4, -4.0], "medium = \"fog\"", &declared, 8, 1, 1),
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("camera.eye") && e.contains("volumes[0]") && e.contains("\"fog\""),
+        "{e}"
+    );
     let mut large = VdbGrid::float("density", [1, 1, 1], |_, _, _| 1.0);
     large.voxels.insert([4000, 4000, 4000], 1.0);
     std::fs::write(path.join("large.vdb"), write_vdb(&[large])).unwrap();

@@ -333,3 +333,46 @@ pub(super) fn subsurface_media(
     }
     Ok(filled)
 }
+
+/// The medium the camera starts in, once volumes are placed: `declared` (`[camera] medium`),
+/// or the grid medium of the one volume whose box holds the eye. A camera inside a volume
+/// needs no declaration, as no file could name the volume's medium (each volume's is a copy
+/// of its own); one inside a volume and a declared medium, or inside two volumes, is refused:
+/// a camera starts in one medium above the global one.
+pub(super) fn camera_in_volume(
+    media: &MediaNames,
+    boundaries: &[(u32, u32)],
+    eye: glam::Vec3,
+    declared: Option<u32>,
+) -> Result<Option<u32>, String> {
+    let holding: Vec<u32> = boundaries
+        .iter()
+        .map(|&(_, medium)| medium)
+        .filter(|&m| {
+            media.list[m as usize]
+                .grid
+                .as_ref()
+                .is_some_and(|g| g.grid.box_contains(&g.placement, eye))
+        })
+        .collect();
+    let name = |m: u32| media.list[m as usize].name.clone();
+    match (holding.as_slice(), declared) {
+        ([], _) => Ok(declared),
+        ([volume], None) => Ok(Some(*volume)),
+        ([volume], Some(declared)) => Err(format!(
+            "the camera is inside the box of {} and also in medium {:?} ([camera] medium); \
+                 glint starts a camera in one medium: move the eye out of the volume's box",
+            name(*volume),
+            name(declared)
+        )),
+        (several, _) => Err(format!(
+            "the camera is inside the boxes of {}; glint starts a camera in one medium: \
+                 move the eye out of all but one",
+            several
+                .iter()
+                .map(|&m| name(m))
+                .collect::<Vec<_>>()
+                .join(" and ")
+        )),
+    }
+}

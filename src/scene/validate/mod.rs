@@ -79,6 +79,9 @@ impl SceneToml {
             &subsurface,
         )?;
         objects::place_volumes(&self.volumes, &mut objects, &mut materials, &mut media)?;
+        let camera_medium =
+            media::camera_in_volume(&media, &objects.boundaries, camera.eye, camera_medium)
+                .map_err(|m| whole("camera.eye", m))?;
         if objects.boundaries.len() + 2 > MAX_MEDIUM_SLOTS {
             return Err(whole(
                 "media",
