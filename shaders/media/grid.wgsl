@@ -124,55 +124,105 @@ fn grid_normalised(r: vec3<f32>) -> vec3<f32> {
     return r;
 }
 
+// What one tracker step met (mirror: TrackStep).
+const TRACK_CROSSED: u32 = 0u;
+const TRACK_COLLISION: u32 = 1u;
+const TRACK_EXIT: u32 = 2u;
+const TRACK_CUT: u32 = 3u;
+
+// Tentative collisions against the majorant blocks at `scale` per unit of majorant density:
+// the walk both trackings share (mirror: MajorantTracker). One step is one block crossed or
+// one collision, one iteration of the caller's loop.
+struct MajorantTracker {
+    walk: BlockWalk,
+    t: f32,
+    t_exit: f32,
+    scale: f32,
+    tau: f32,
+    draw_tau: bool,
+    steps: u32,
+    majorant: f32,
+    swept: f32,
+}
+
+fn majorant_tracker(g: GridMedium, o: vec3<f32>, d: vec3<f32>, span: vec2<f32>, scale: f32, rng: ptr<function, Rng>) -> MajorantTracker {
+    let tau = -log(1.0 - rng_next(rng));
+    return MajorantTracker(block_walk(g, o, d, span.x), span.x, span.y, scale, tau, false, 0u, 0.0, 0.0);
+}
+
+fn tracker_step(g: GridMedium, tr: ptr<function, MajorantTracker>, rng: ptr<function, Rng>) -> u32 {
+    if (*tr).draw_tau {
+        (*tr).tau = -log(1.0 - rng_next(rng));
+        (*tr).draw_tau = false;
+    }
+    if (*tr).steps >= MAX_TRACKING_STEPS {
+        return TRACK_CUT;
+    }
+    (*tr).steps += 1u;
+    let t = (*tr).t;
+    let end = max(min(block_walk_end((*tr).walk), (*tr).t_exit), t);
+    let maj = grid_majorant(g, (*tr).walk.cell);
+    let rate = maj * (*tr).scale;
+    if rate > 0.0 && (*tr).tau < rate * (end - t) {
+        let tc = t + (*tr).tau / rate;
+        (*tr).swept += maj * (tc - t);
+        (*tr).t = tc;
+        (*tr).majorant = maj;
+        (*tr).draw_tau = true;
+        return TRACK_COLLISION;
+    }
+    (*tr).tau -= rate * (end - t);
+    (*tr).swept += maj * (end - t);
+    (*tr).t = end;
+    if end >= (*tr).t_exit {
+        return TRACK_EXIT;
+    }
+    // A pointer into *tr as an argument trips naga's SPIR-V writer: advance a copy.
+    var walk = (*tr).walk;
+    let inside = block_walk_advance(g, &walk);
+    (*tr).walk = walk;
+    if !inside {
+        return TRACK_EXIT;
+    }
+    return TRACK_CROSSED;
+}
+
 fn grid_free_flight(m: Medium, ray: Ray, t_max: f32, rng: ptr<function, Rng>) -> FreeFlight {
     let g = grids[m.grid];
     let sigma_t = m.sigma_t;
     let sigma_s = m.sigma_s;
     let u_channel = rng_next(rng);
     let channel = min(u32(u_channel * 3.0), 2u);
-    let s = sigma_t[channel];
     let lowest = min(sigma_t.x, min(sigma_t.y, sigma_t.z));
     let o = to_grid(g, ray.origin);
     let d = dir_to_grid(g, ray.dir);
     let span = grid_clip(g, o, d, t_max);
-    let t_enter = span.x;
-    let t_exit = span.y;
     var r = vec3<f32>(1.0);
-    if t_enter < t_exit {
-        var walk = block_walk(g, o, d, t_enter);
-        var tau = -log(1.0 - rng_next(rng));
-        var t = t_enter;
-        var steps = 0u;
+    if span.x < span.y {
+        var tracker = majorant_tracker(g, o, d, span, sigma_t[channel], rng);
         loop {
-            if steps >= MAX_TRACKING_STEPS {
+            let step = tracker_step(g, &tracker, rng);
+            if step == TRACK_CUT {
                 return FreeFlight(t_max, vec3<f32>(0.0), false);
             }
-            steps += 1u;
-            let end = max(min(block_walk_end(walk), t_exit), t);
-            let maj = grid_majorant(g, walk.cell);
-            let rate = maj * s;
-            if rate > 0.0 && tau < rate * (end - t) {
-                let tc = t + tau / rate;
-                r = grid_normalised(r * exp(-((sigma_t - vec3<f32>(lowest)) * (maj * (tc - t)))));
-                let dens = grid_density(g, o + tc * d);
-                if rng_next(rng) * maj < dens {
-                    let pdf = dot(sigma_t * r, vec3<f32>(1.0 / 3.0));
-                    if pdf > 0.0 {
-                        return FreeFlight(tc, sigma_s * r / pdf, true);
-                    }
-                    return FreeFlight(t_max, vec3<f32>(0.0), false);
-                }
-                r = grid_normalised(r * sigma_t);
-                t = tc;
-                tau = -log(1.0 - rng_next(rng));
+            if step == TRACK_CROSSED {
                 continue;
             }
-            tau -= rate * (end - t);
-            r = grid_normalised(r * exp(-((sigma_t - vec3<f32>(lowest)) * (maj * (end - t)))));
-            t = end;
-            if end >= t_exit || !block_walk_advance(g, &walk) {
+            r = grid_normalised(r * exp(-((sigma_t - vec3<f32>(lowest)) * tracker.swept)));
+            tracker.swept = 0.0;
+            if step == TRACK_EXIT {
                 break;
             }
+            let tc = tracker.t;
+            let dens = grid_density(g, o + tc * d);
+            if rng_next(rng) * tracker.majorant < dens {
+                let pdf = dot(sigma_t * r, vec3<f32>(1.0 / 3.0));
+                if pdf > 0.0 {
+                    return FreeFlight(tc, sigma_s * r / pdf, true);
+                }
+                return FreeFlight(t_max, vec3<f32>(0.0), false);
+            }
+            r = grid_normalised(r * sigma_t);
         }
     }
     let survival = dot(r, vec3<f32>(1.0 / 3.0));
@@ -189,39 +239,26 @@ fn grid_transmittance(m: Medium, ray: Ray, t_end: f32, rng: ptr<function, Rng>) 
     let o = to_grid(g, ray.origin);
     let d = dir_to_grid(g, ray.dir);
     let span = grid_clip(g, o, d, t_end);
-    let t_enter = span.x;
-    let t_exit = span.y;
     var through = vec3<f32>(1.0);
-    if top <= 0.0 || t_enter >= t_exit {
+    if top <= 0.0 || span.x >= span.y {
         return through;
     }
-    var walk = block_walk(g, o, d, t_enter);
-    var tau = -log(1.0 - rng_next(rng));
-    var t = t_enter;
-    var steps = 0u;
+    var tracker = majorant_tracker(g, o, d, span, top, rng);
     loop {
-        if steps >= MAX_TRACKING_STEPS {
+        let step = tracker_step(g, &tracker, rng);
+        if step == TRACK_CUT {
             return vec3<f32>(0.0);
         }
-        steps += 1u;
-        let end = max(min(block_walk_end(walk), t_exit), t);
-        let maj = grid_majorant(g, walk.cell);
-        let rate = maj * top;
-        if rate > 0.0 && tau < rate * (end - t) {
-            let tc = t + tau / rate;
-            let dens = grid_density(g, o + tc * d);
+        if step == TRACK_EXIT {
+            return through;
+        }
+        if step == TRACK_COLLISION {
+            let dens = grid_density(g, o + tracker.t * d);
+            let rate = tracker.majorant * top;
             through *= max(vec3<f32>(1.0) - sigma_t * (dens / rate), vec3<f32>(0.0));
             if max(through.x, max(through.y, through.z)) <= 0.0 {
                 return vec3<f32>(0.0);
             }
-            t = tc;
-            tau = -log(1.0 - rng_next(rng));
-            continue;
-        }
-        tau -= rate * (end - t);
-        t = end;
-        if end >= t_exit || !block_walk_advance(g, &walk) {
-            break;
         }
     }
     return through;

@@ -201,6 +201,102 @@ fn decay(x: Vec3) -> Vec3 {
     Vec3::new((-x.x).exp(), (-x.y).exp(), (-x.z).exp())
 }
 
+/// What one step of a [`MajorantTracker`] met.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrackStep {
+    /// Crossed a block without a tentative collision: step again.
+    Crossed,
+    /// A tentative collision at `tracker.t`, with the block's majorant `tracker.majorant`.
+    Collision,
+    /// Reached the segment's end (or left the grid) without one.
+    Exit,
+    /// Took [`MAX_TRACKING_STEPS`] steps: the caller absorbs or blocks.
+    Cut,
+}
+
+/// Tentative collisions along a ray through a grid, sampled against the majorant blocks the
+/// ray crosses at `scale` per unit of majorant density: the walk both trackings share.
+/// Each [`MajorantTracker::step`] is one block crossed or one collision (a loop iteration of
+/// the kernel, `src/gpu/loop_budget.rs` counts them).
+#[derive(Clone, Copy, Debug)]
+pub struct MajorantTracker {
+    walk: BlockWalk,
+    /// Where the tracking is, in the grid's frame along the ray.
+    pub t: f32,
+    t_exit: f32,
+    scale: f32,
+    /// The exponential optical depth left to the next tentative collision.
+    tau: f32,
+    /// Whether `tau` is spent (a collision happened) and the next step draws a new one.
+    draw_tau: bool,
+    steps: u32,
+    /// The majorant of the block of the last collision.
+    pub majorant: f32,
+    /// ∫ m dt since the caller last took it: the majorant's optical depth (per unit of the
+    /// coefficients) swept since.
+    pub swept: f32,
+}
+
+impl MajorantTracker {
+    /// Tracking over [t_enter, t_exit] (inside the grid's box) of the grid-frame ray (o, d);
+    /// draws the first exponential from `rng`.
+    pub fn new(
+        g: &GridMedium,
+        o: Vec3,
+        d: Vec3,
+        span: (f32, f32),
+        scale: f32,
+        rng: &mut Rng,
+    ) -> Self {
+        MajorantTracker {
+            walk: BlockWalk::new(g, o, d, span.0),
+            t: span.0,
+            t_exit: span.1,
+            scale,
+            tau: -(1.0 - rng.next_f32()).ln(),
+            draw_tau: false,
+            steps: 0,
+            majorant: 0.0,
+            swept: 0.0,
+        }
+    }
+
+    /// The majorant optical depth swept since the last call.
+    pub fn take_swept(&mut self) -> f32 {
+        std::mem::take(&mut self.swept)
+    }
+
+    pub fn step(&mut self, grids: Grids, g: &GridMedium, rng: &mut Rng) -> TrackStep {
+        if self.draw_tau {
+            self.tau = -(1.0 - rng.next_f32()).ln();
+            self.draw_tau = false;
+        }
+        if self.steps >= MAX_TRACKING_STEPS {
+            return TrackStep::Cut;
+        }
+        self.steps += 1;
+        let t = self.t;
+        let end = self.walk.t_end().min(self.t_exit).max(t);
+        let maj = majorant(grids.voxels, g, self.walk.cell);
+        let rate = maj * self.scale;
+        if rate > 0.0 && self.tau < rate * (end - t) {
+            let tc = t + self.tau / rate;
+            self.swept += maj * (tc - t);
+            self.t = tc;
+            self.majorant = maj;
+            self.draw_tau = true;
+            return TrackStep::Collision;
+        }
+        self.tau -= rate * (end - t);
+        self.swept += maj * (end - t);
+        self.t = end;
+        if end >= self.t_exit || !self.walk.advance(g) {
+            return TrackStep::Exit;
+        }
+        TrackStep::Crossed
+    }
+}
+
 /// A free flight through grid medium `m` along `ray` towards a surface at `t_max`, by delta
 /// tracking (the module's doc); `rng` is the flight's stream, whose first draw picks the
 /// channel.
@@ -216,7 +312,6 @@ pub fn grid_free_flight(
     let sigma_s = Vec3::from(m.sigma_s);
     let u_channel = rng.next_f32();
     let channel = ((u_channel * 3.0) as usize).min(2);
-    let s = sigma_t[channel];
     let lowest = sigma_t.min_element();
     let o = to_grid(g, ray.origin);
     let d = dir_to_grid(g, ray.dir);
@@ -228,45 +323,35 @@ pub fn grid_free_flight(
     };
     let mut r = Vec3::ONE;
     if t_enter < t_exit {
-        let mut walk = BlockWalk::new(g, o, d, t_enter);
-        let mut tau = -(1.0 - rng.next_f32()).ln();
-        let mut t = t_enter;
-        let mut steps = 0;
+        let mut tracker = MajorantTracker::new(g, o, d, (t_enter, t_exit), sigma_t[channel], rng);
         loop {
-            if steps >= MAX_TRACKING_STEPS {
-                return absorbed;
+            let step = tracker.step(grids, g, rng);
+            match step {
+                TrackStep::Cut => return absorbed,
+                TrackStep::Crossed => continue,
+                TrackStep::Collision | TrackStep::Exit => {}
             }
-            steps += 1;
-            let end = walk.t_end().min(t_exit).max(t);
-            let maj = majorant(grids.voxels, g, walk.cell);
-            let rate = maj * s;
-            if rate > 0.0 && tau < rate * (end - t) {
-                // A tentative collision in this block.
-                let tc = t + tau / rate;
-                r = normalised(r * decay((sigma_t - Vec3::splat(lowest)) * (maj * (tc - t))));
-                let dens = density(grids.voxels, g, o + tc * d);
-                if rng.next_f32() * maj < dens {
-                    let pdf = (sigma_t * r).dot(Vec3::splat(1.0 / 3.0));
-                    if pdf > 0.0 {
-                        return FreeFlight {
-                            t: tc,
-                            weight: sigma_s * r / pdf,
-                            scattered: true,
-                        };
-                    }
-                    return absorbed;
-                }
-                r = normalised(r * sigma_t);
-                t = tc;
-                tau = -(1.0 - rng.next_f32()).ln();
-                continue;
-            }
-            tau -= rate * (end - t);
-            r = normalised(r * decay((sigma_t - Vec3::splat(lowest)) * (maj * (end - t))));
-            t = end;
-            if end >= t_exit || !walk.advance(g) {
+            // Each channel's chance of no collision over the swept majorant, relative to the
+            // lowest's (module doc).
+            let swept = tracker.take_swept();
+            r = normalised(r * decay((sigma_t - Vec3::splat(lowest)) * swept));
+            if step == TrackStep::Exit {
                 break;
             }
+            let tc = tracker.t;
+            let dens = density(grids.voxels, g, o + tc * d);
+            if rng.next_f32() * tracker.majorant < dens {
+                let pdf = (sigma_t * r).dot(Vec3::splat(1.0 / 3.0));
+                if pdf > 0.0 {
+                    return FreeFlight {
+                        t: tc,
+                        weight: sigma_s * r / pdf,
+                        scattered: true,
+                    };
+                }
+                return absorbed;
+            }
+            r = normalised(r * sigma_t);
         }
     }
     let survival = r.dot(Vec3::splat(1.0 / 3.0));
@@ -293,34 +378,20 @@ pub fn grid_transmittance(grids: Grids, m: &Medium, ray: &Ray, t_end: f32, rng: 
     if top <= 0.0 || t_enter >= t_exit {
         return through;
     }
-    let mut walk = BlockWalk::new(g, o, d, t_enter);
-    let mut tau = -(1.0 - rng.next_f32()).ln();
-    let mut t = t_enter;
-    let mut steps = 0;
+    let mut tracker = MajorantTracker::new(g, o, d, (t_enter, t_exit), top, rng);
     loop {
-        if steps >= MAX_TRACKING_STEPS {
-            return Vec3::ZERO;
-        }
-        steps += 1;
-        let end = walk.t_end().min(t_exit).max(t);
-        let maj = majorant(grids.voxels, g, walk.cell);
-        let rate = maj * top;
-        if rate > 0.0 && tau < rate * (end - t) {
-            let tc = t + tau / rate;
-            let dens = density(grids.voxels, g, o + tc * d);
-            through *= (Vec3::ONE - sigma_t * (dens / rate)).max(Vec3::ZERO);
-            if through.max_element() <= 0.0 {
-                return Vec3::ZERO;
+        match tracker.step(grids, g, rng) {
+            TrackStep::Cut => return Vec3::ZERO,
+            TrackStep::Exit => return through,
+            TrackStep::Crossed => {}
+            TrackStep::Collision => {
+                let dens = density(grids.voxels, g, o + tracker.t * d);
+                let rate = tracker.majorant * top;
+                through *= (Vec3::ONE - sigma_t * (dens / rate)).max(Vec3::ZERO);
+                if through.max_element() <= 0.0 {
+                    return Vec3::ZERO;
+                }
             }
-            t = tc;
-            tau = -(1.0 - rng.next_f32()).ln();
-            continue;
-        }
-        tau -= rate * (end - t);
-        t = end;
-        if end >= t_exit || !walk.advance(g) {
-            break;
         }
     }
-    through
 }
