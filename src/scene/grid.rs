@@ -19,6 +19,10 @@ use std::path::Path;
 /// storage binding, which also holds the majorants.
 pub const MAX_GRID_VOXELS: u64 = (1 << 25) - (1 << 20);
 
+/// The largest factor a grid is averaged down by to fit [`MAX_GRID_VOXELS`]: beyond it, so
+/// much detail would go that the file is refused instead.
+pub const MAX_DOWNSAMPLE: u32 = 4;
+
 /// Voxels per edge of a majorant block (`GridMedium::block`).
 pub const MAJORANT_BLOCK: u32 = 8;
 
@@ -37,6 +41,11 @@ pub struct DensityGrid {
     pub density: Vec<f32>,
     /// Continuous grid coordinates (voxel i's centre at i + ½) to the grid's own space.
     pub grid_to_object: Mat4,
+    /// 1 when the file's voxels are these; f when each of these is the mean of f³ of the
+    /// file's (a grid too large for one binding, [`MAX_GRID_VOXELS`]).
+    pub downsampled: u32,
+    /// The size of the file's grid around its active values, before any downsampling.
+    pub read_dims: [u32; 3],
 }
 
 impl DensityGrid {
@@ -169,6 +178,55 @@ fn quietly<T>(f: impl FnOnce() -> T + std::panic::UnwindSafe) -> std::thread::Re
 /// The grid types glint reads: 32-bit float grids (also those saved as half floats).
 const FLOAT_GRID: &str = "Tree_float_5_4_3";
 
+/// The smallest factor f (at most [`MAX_DOWNSAMPLE`]) such that the grid of `size` voxels
+/// averaged over f³ blocks fits one binding: 1 when it fits as it is.
+fn downsample_factor(size: glam::I64Vec3) -> Option<i64> {
+    (1..=MAX_DOWNSAMPLE as i64).find(|&f| {
+        let c = (size + glam::I64Vec3::splat(f - 1)) / f;
+        (c.x as u64)
+            .saturating_mul(c.y as u64)
+            .saturating_mul(c.z as u64)
+            <= MAX_GRID_VOXELS
+    })
+}
+
+/// The dense grid of `dims` voxels, each the mean density of the `factor`³ fine voxels it
+/// covers (a box filter: the medium's mass, ∫ density, is kept), from the active `values`
+/// (origin, tile side, density) of a grid whose lowest active voxel is `lo`. Each value adds
+/// to the coarse voxels its tile overlaps in proportion to the overlap, so a large tile costs
+/// the coarse voxels it covers, not its fine ones.
+fn box_filtered(
+    values: impl Iterator<Item = (IVec3, i32, f32)>,
+    lo: IVec3,
+    dims: [u32; 3],
+    factor: i64,
+) -> Vec<f32> {
+    let mut density = vec![0.0f32; dims.iter().map(|&d| d as usize).product()];
+    let per_fine = 1.0 / (factor * factor * factor) as f32;
+    // The coarse cells a run [start, start + side) of fine voxels overlaps, and by how much.
+    let overlaps = |start: i64, side: i64| {
+        let first = start / factor;
+        let last = (start + side - 1) / factor;
+        (first..=last).map(move |c| {
+            let covered = (start + side).min((c + 1) * factor) - start.max(c * factor);
+            (c as usize, covered as f32)
+        })
+    };
+    for (origin, side, value) in values {
+        let o = (origin - lo).as_i64vec3();
+        let side = side as i64;
+        for (z, wz) in overlaps(o.z, side) {
+            for (y, wy) in overlaps(o.y, side) {
+                let row = (z * dims[1] as usize + y) * dims[0] as usize;
+                for (x, wx) in overlaps(o.x, side) {
+                    density[row + x] += value * (wx * wy * wz * per_fine);
+                }
+            }
+        }
+    }
+    density
+}
+
 fn read_with_vdb_rs(bytes: &[u8], grid_name: &str, shown: &str) -> Result<DensityGrid, String> {
     let broken = |e: vdb_rs::ParseError| format!("{shown} is a broken OpenVDB file: {e:?}");
     let mut reader = vdb_rs::VdbReader::new(Cursor::new(bytes)).map_err(broken)?;
@@ -226,10 +284,20 @@ fn read_with_vdb_rs(bytes: &[u8], grid_name: &str, shown: &str) -> Result<Densit
         ));
     }
     // The active values: voxels, and tiles of 8³ and 128³ voxels.
-    let mut values = Vec::new();
+    // Two passes over the tree: this one checks the values and bounds them, the fill below
+    // reads them again (a large grid's values need not all be held at once).
+    let active = || {
+        grid.iter()
+            .filter(|(_, value, _)| *value != 0.0)
+            .map(|(at, value, level)| {
+                // vdb-rs's glam is not glint's: by components.
+                let origin = IVec3::new(at.x as i32, at.y as i32, at.z as i32);
+                (origin, level.scale() as i32, value)
+            })
+    };
     let mut lo = IVec3::MAX;
     let mut hi = IVec3::MIN;
-    for (at, value, level) in grid.iter() {
+    for (at, value, _) in grid.iter() {
         if !value.is_finite() {
             return Err(format!(
                 "grid {grid_name:?} of {shown} holds a density that is not finite ({value}) at \
@@ -251,58 +319,47 @@ fn read_with_vdb_rs(bytes: &[u8], grid_name: &str, shown: &str) -> Result<Densit
                 [at.x, at.y, at.z]
             ));
         }
-        if value == 0.0 {
-            continue;
-        }
-        let side = level.scale() as i32;
-        // vdb-rs's glam is not glint's: by components.
-        let origin = IVec3::new(at.x as i32, at.y as i32, at.z as i32);
+    }
+    for (origin, side, _) in active() {
         lo = lo.min(origin);
         hi = hi.max(origin + IVec3::splat(side - 1));
-        values.push((origin, side, value));
     }
-    if values.is_empty() {
+    if lo.x > hi.x {
         return Err(format!(
             "grid {grid_name:?} of {shown} has no positive density: the medium would be empty"
         ));
     }
     let size = (hi - lo).as_i64vec3() + glam::I64Vec3::splat(1);
-    let voxels = size.x as u64 * size.y as u64 * size.z as u64;
-    if voxels > MAX_GRID_VOXELS {
+    let fine_voxels = size.x as u64 * size.y as u64 * size.z as u64;
+    let Some(factor) = downsample_factor(size) else {
         return Err(format!(
             "grid {grid_name:?} of {shown} spans {} × {} × {} voxels around its active values \
-             ({:.0} MiB as 32-bit floats), more than the {} MiB one GPU binding holds; resample \
-             it coarser (a larger voxel size) before rendering",
+             ({:.0} MiB as 32-bit floats), more than the {} MiB one GPU binding holds even \
+             averaged over {MAX_DOWNSAMPLE}³ blocks; resample it coarser (a larger voxel size) \
+             before rendering",
             size.x,
             size.y,
             size.z,
-            voxels as f64 * 4.0 / (1u64 << 20) as f64,
+            fine_voxels as f64 * 4.0 / (1u64 << 20) as f64,
             (MAX_GRID_VOXELS * 4) >> 20
         ));
-    }
-    let dims = [size.x as u32, size.y as u32, size.z as u32];
-    let mut density = vec![0.0f32; voxels as usize];
-    let base = lo;
-    for (origin, side, value) in values {
-        let o = origin - base;
-        for z in o.z..o.z + side {
-            for y in o.y..o.y + side {
-                let row = (z as usize * dims[1] as usize + y as usize) * dims[0] as usize;
-                for x in o.x..o.x + side {
-                    density[row + x as usize] = value;
-                }
-            }
-        }
-    }
-    // VDB voxel v's centre is at v · voxel_size + translation; array voxel i is VDB voxel
-    // i + base, its centre at continuous coordinate i + ½.
+    };
+    let coarse = (size + glam::I64Vec3::splat(factor - 1)) / factor;
+    let dims = [coarse.x as u32, coarse.y as u32, coarse.z as u32];
+    let density = box_filtered(active(), lo, dims, factor);
+    // VDB voxel v's centre is at v · voxel_size + translation; fine voxel i is VDB voxel
+    // i + lo, its centre at continuous coordinate i + ½, and coarse voxel j spans fine
+    // coordinates [f j, f (j + 1)).
     let grid_to_object = Mat4::from_translation(translation)
         * Mat4::from_scale(voxel_size)
-        * Mat4::from_translation(base.as_vec3() - Vec3::splat(0.5));
+        * Mat4::from_translation(lo.as_vec3() - Vec3::splat(0.5))
+        * Mat4::from_scale(Vec3::splat(factor as f32));
     Ok(DensityGrid {
         source: format!("{shown}:{grid_name}"),
         dims,
         density,
         grid_to_object,
+        downsampled: factor as u32,
+        read_dims: [size.x as u32, size.y as u32, size.z as u32],
     })
 }

@@ -592,3 +592,62 @@ fn glint_render_refuses_unreadable_grids_cleanly() {
         assert!(!err.contains("panicked"), "{file}: {err}");
     }
 }
+
+/// A grid too large for one binding (330³ voxels around its active values, 137 MiB) is
+/// averaged over 2³ blocks, with a warning naming the file, the sizes and the factor: each
+/// coarse voxel the mean of the 8 it covers (so the medium's mass, the sum of densities times
+/// the voxel volume, is kept), placed where those 8 were. Beyond a factor of 4 it is refused
+/// (the 4001³ grid of `bad_grids_are_refused_with_named_errors`).
+#[test]
+fn a_grid_too_large_for_one_binding_is_averaged_down() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut grid = VdbGrid::float("density", [1, 1, 1], |_, _, _| 1.0);
+    for (at, value) in [
+        ([329, 329, 329], 2.0),
+        ([100, 101, 102], 4.0),
+        ([101, 101, 102], 4.0),
+        ([100, 100, 103], 8.0),
+    ] {
+        grid.voxels.insert(at, value);
+    }
+    grid.voxel_size = 0.01;
+    let bytes = write_vdb(std::slice::from_ref(&grid));
+    let read = glint::scene::grid::parse_density_grid(&bytes, "density", "big.vdb").unwrap();
+    assert_eq!(read.downsampled, 2);
+    assert_eq!(read.read_dims, [330; 3]);
+    assert_eq!(read.dims, [165; 3]);
+    let coarse = |x: usize, y: usize, z: usize| read.density[x + 165 * (y + 165 * z)];
+    assert_eq!(coarse(0, 0, 0), 1.0 / 8.0);
+    assert_eq!(coarse(164, 164, 164), 2.0 / 8.0);
+    // Fine voxels (100, 101, 102), (101, 101, 102) and (100, 100, 103) share coarse (50, 50, 51).
+    assert_eq!(coarse(50, 50, 51), 16.0 / 8.0);
+    let mass: f64 = read.density.iter().map(|&d| d as f64).sum::<f64>() * 8.0;
+    assert_eq!(mass, 1.0 + 2.0 + 4.0 + 4.0 + 8.0);
+    // Coarse voxel (50, 50, 51)'s centre is the corner the 8 fine voxels share: VDB index
+    // coordinates (100.5, 100.5, 102.5), times the voxel size.
+    let centre = read
+        .grid_to_object
+        .transform_point3(Vec3::new(50.5, 50.5, 51.5));
+    assert!(
+        (centre - Vec3::new(1.005, 1.005, 1.025))
+            .abs()
+            .max_element()
+            < 1e-5,
+        "{centre}"
+    );
+
+    std::fs::write(dir.path().join("big.vdb"), &bytes).unwrap();
+    let more = "[media.smoke]\ngrid = \"big.vdb\"\nsigma_s = [1.0, 1.0, 1.0]\n\
+                [[volumes]]\nmedium = \"smoke\"\ntranslate = [-1.6, -1.6, 2.0]\n";
+    std::fs::write(dir.path().join("scene.toml"), scene_text(more, 4, 1, 1)).unwrap();
+    let out = common::glint_ok(
+        dir.path(),
+        &["render", "scene.toml", "--cpu", "-o", "out.exr"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("big.vdb:density: the grid spans 330 × 330 × 330 voxels")
+            && stderr.contains("averaged it over 2³ blocks to 165 × 165 × 165 voxels"),
+        "{stderr}"
+    );
+}

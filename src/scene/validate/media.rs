@@ -376,3 +376,25 @@ pub(super) fn camera_in_volume(
         )),
     }
 }
+
+/// One warning per grid that was averaged down to fit one GPU binding, naming its file and
+/// grid, the sizes and the factor (volumes' copies of a medium share its grid: said once).
+pub(super) fn downsampling_warnings(media: &MediaNames) -> Vec<String> {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut out = Vec::new();
+    for grid in media.list.iter().filter_map(|m| m.grid.as_ref()) {
+        let g = &grid.grid;
+        if g.downsampled > 1 && seen.insert(g.source.clone()) {
+            let [x, y, z] = g.read_dims;
+            let [cx, cy, cz] = g.dims;
+            out.push(format!(
+                "{}: the grid spans {x} × {y} × {z} voxels, more than one GPU binding holds; \
+                 glint averaged it over {f}³ blocks to {cx} × {cy} × {cz} voxels (detail finer \
+                 than {f} voxels is lost; resample the grid coarser to choose how)",
+                g.source,
+                f = g.downsampled
+            ));
+        }
+    }
+    out
+}

@@ -100,6 +100,7 @@ impl SceneToml {
             ));
         }
         let mut warnings = objects.warnings;
+        warnings.extend(media::downsampling_warnings(&media));
         let environment = match &self.environment {
             Some(e) => {
                 let environment =
