@@ -14,8 +14,8 @@ use glint::kernel::KernelScene;
 use glint::render::batch_means::BatchMeans;
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use glint::scene::{
-    self as scenes, Integrator, LightSampler, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE,
-    MAX_SPP,
+    self as scenes, Integrator, LightSampler, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT,
+    MAX_IMAGE_SIDE, MAX_SPP,
 };
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
