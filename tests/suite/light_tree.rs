@@ -319,3 +319,33 @@ fn no_tree_for_one_emitter_nor_for_bdpt() {
     );
     assert_eq!(bdpt.params.light_tree_nodes, 0);
 }
+
+/// `--light-sampler` overrides `[render] light_sampler` and shows in `--json`; an unknown
+/// name in the scene file is refused with the known ones.
+#[test]
+fn light_sampler_switch_on_the_command_line_and_in_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.toml"), many_lights_toml(3, 4, "power")).unwrap();
+    let out = common::glint_ok(
+        dir.path(),
+        &[
+            "render",
+            "--cpu",
+            "m.toml",
+            "-o",
+            "m.exr",
+            "--json",
+            "--light-sampler",
+            "tree",
+        ],
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["light_sampler"], "tree");
+    let bad = many_lights_toml(3, 4, "bvh");
+    let err = glint::scene::Scene::parse(&bad, std::path::Path::new("bad.toml")).unwrap_err();
+    let message = err.to_string();
+    assert!(
+        message.contains("render.light_sampler") && message.contains("\"tree\", \"power\""),
+        "{message}"
+    );
+}
