@@ -304,7 +304,8 @@ fn gpu_tree_renders_the_cpu_image_and_traces_its_paths() {
 }
 
 /// A scene with one finite emitter builds no tree (picking it costs nothing), nor does
-/// bidirectional path tracing, which keeps the choice by power.
+/// bidirectional path tracing, which keeps the choice by power; the tree is part of the
+/// settings a partial render's hash covers.
 #[test]
 fn no_tree_for_one_emitter_nor_for_bdpt() {
     let one = common::kernel_scene(
@@ -318,6 +319,12 @@ fn no_tree_for_one_emitter_nor_for_bdpt() {
             .replace("max_bounces = 2", "max_bounces = 2\nintegrator = \"bdpt\""),
     );
     assert_eq!(bdpt.params.light_tree_nodes, 0);
+    // A render with the tree does not resume or merge with one by power.
+    use glint::render::partial::settings_hash;
+    assert_ne!(
+        settings_hash(&many_lights(4, 8, 0, "tree")),
+        settings_hash(&many_lights(4, 8, 0, "power"))
+    );
 }
 
 /// `--light-sampler` overrides `[render] light_sampler` and shows in `--json`; an unknown
