@@ -67,6 +67,7 @@ def render(
     light_sampling=None,
     sampler=None,
     integrator=None,
+    light_sampler=None,
     device="auto",
     traversal="auto",
     variance=False,
@@ -80,7 +81,8 @@ def render(
 
     The keyword arguments are `glint render`'s overrides, with the same names and meanings:
     spp, width, height, max_bounces, seed, light_sampling (True/False or "on"/"off"), sampler
-    ("independent" or "sobol"), integrator ("path" or "bdpt"); None keeps the scene's value.
+    ("independent" or "sobol"), integrator ("path" or "bdpt"), light_sampler ("tree" or "power");
+    None keeps the scene's value.
     device is "auto" (the GPU if there is one, else the CPU reference; bdpt renders on the CPU
     reference, as `glint render` does without --gpu), "gpu" (or a RuntimeError) or "cpu". time_limit (seconds) stops at the first
     batch boundary after it; progress prints the sample count on stderr. denoise=True runs
@@ -125,6 +127,7 @@ def render(
         light_sampling=_on_off(light_sampling),
         sampler=sampler,
         integrator=integrator,
+        light_sampler=light_sampler,
         device=device,
         traversal=traversal,
         variance=bool(variance),

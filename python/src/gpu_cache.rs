@@ -28,11 +28,12 @@ pub struct GpuCache {
 
 /// Whether a renderer made for `a` renders `b` once given `b`'s parameters: everything but
 /// the camera, spp, seed, max_bounces, the background, light sampling and the sampler (all in
-/// `Params`) is the same.
+/// `Params`) is the same. The light sampler is not only `Params`: the tree is its own buffer.
 pub fn same_objects(a: &scenes::Scene, b: &scenes::Scene) -> bool {
     a.render.width == b.render.width
         && a.render.height == b.render.height
         && a.render.russian_roulette == b.render.russian_roulette
+        && a.render.light_sampler == b.render.light_sampler
         && a.materials == b.materials
         && a.spheres == b.spheres
         && a.quads == b.quads

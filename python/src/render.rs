@@ -14,8 +14,8 @@ use glint::kernel::KernelScene;
 use glint::render::batch_means::BatchMeans;
 use glint::render::{relative_error, render_progressive, BatchSizer, Renderer, StopRules};
 use glint::scene::{
-    self as scenes, Integrator, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE,
-    MAX_SPP,
+    self as scenes, Integrator, LightSampler, RenderOverrides, Sampler, MAX_BOUNCES_LIMIT,
+    MAX_IMAGE_SIDE, MAX_SPP,
 };
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -263,7 +263,7 @@ fn run_gpu(
 /// the image and the other outputs as H×W×3 float32 NumPy arrays, and the statistics.
 #[pyfunction]
 #[pyo3(signature = (scene, *, spp=None, width=None, height=None, max_bounces=None, seed=None,
-    light_sampling=None, sampler=None, integrator=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
+    light_sampling=None, sampler=None, integrator=None, light_sampler=None, device="auto", traversal="auto", variance=false, aovs=false, denoise=false,
     time_limit=None, progress=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
@@ -277,6 +277,7 @@ pub fn render<'py>(
     light_sampling: Option<bool>,
     sampler: Option<&str>,
     integrator: Option<&str>,
+    light_sampler: Option<&str>,
     device: &str,
     traversal: &str,
     variance: bool,
@@ -309,6 +310,15 @@ pub fn render<'py>(
                 Integrator::from_name(s).ok_or_else(|| {
                     PyValueError::new_err(format!(
                         "integrator: expected \"path\" or \"bdpt\", got {s:?}"
+                    ))
+                })
+            })
+            .transpose()?,
+        light_sampler: light_sampler
+            .map(|s| {
+                LightSampler::from_name(s).ok_or_else(|| {
+                    PyValueError::new_err(format!(
+                        "light_sampler: expected \"tree\" or \"power\", got {s:?}"
                     ))
                 })
             })
@@ -408,6 +418,7 @@ pub fn render<'py>(
     stats.set_item("light_sampling", r.light_sampling)?;
     stats.set_item("sampler", r.sampler.name())?;
     stats.set_item("integrator", r.integrator.name())?;
+    stats.set_item("light_sampler", r.light_sampler.name())?;
     stats.set_item("paths", paths)?;
     stats.set_item("seconds", rendered.seconds)?;
     stats.set_item(

@@ -182,3 +182,12 @@ def test_a_model_file_is_a_scene_as_on_the_command_line(cli, root, tmp_path):
     assert not np.array_equal(glint.render(scene, device="cpu", **settings), image)
     with pytest.raises(glint.SceneError, match="camera applies to a model file"):
         glint.load(root / "scenes" / "cornell.toml", camera=1)
+
+
+def test_light_sampler_kwarg_picks_the_tree_or_power(cornell):
+    tree = glint.render(glint.load(cornell), device="cpu", full=True, light_sampler="tree", **SETTINGS)
+    assert tree.stats["light_sampler"] == "tree"
+    power = glint.render(glint.load(cornell), device="cpu", full=True, light_sampler="power", **SETTINGS)
+    assert power.stats["light_sampler"] == "power"
+    with pytest.raises(ValueError, match="light_sampler"):
+        glint.render(glint.load(cornell), light_sampler="bvh")

@@ -66,6 +66,10 @@ struct Params {
     global_medium: u32,
     camera_medium: u32,
     media: array<Medium, 8>,
+    // The light tree's nodes (0: none; the alias table picks every emitter) and the
+    // probability of picking a finite emitter, one in the tree (lights/light_tree.wgsl).
+    light_tree_nodes: u32,
+    light_tree_probability: f32,
 }
 
 const NO_MEDIUM: u32 = 0xffffffffu;
@@ -207,6 +211,23 @@ const NO_TEXTURE: u32 = 0xffffffffu;
 const PRIMITIVE_SPHERE: u32 = 0u;
 const PRIMITIVE_QUAD: u32 = 1u;
 const PRIMITIVE_TRIANGLE: u32 = 2u;
+
+// A node of the light tree (src/kernel/types.rs): its emitters' box, power, normal cone
+// (axis, cos theta_o), emission spread (cos theta_e) and whether any emits from both sides;
+// the first child follows an interior node, `child` is its second; a leaf (child 0) holds one
+// emitter (primitive, index).
+struct LightTreeNode {
+    lo: vec3<f32>,
+    phi: f32,
+    hi: vec3<f32>,
+    cos_theta_o: f32,
+    axis: vec3<f32>,
+    cos_theta_e: f32,
+    child: u32,
+    primitive: u32,
+    index: u32,
+    two_sided: u32,
+}
 
 // A mesh triangle: what intersection and light sampling read. Its unit normal is
 // normalize(cross(v1 - v0, v2 - v0)).

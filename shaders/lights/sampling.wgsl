@@ -1,5 +1,6 @@
 // Light sampling for next-event estimation (mirror: src/cpu/lights/sampling.rs). An emitter is chosen
-// in proportion to its power, then a direction towards it: quads and triangles by area, spheres by the cone
+// in proportion to its power, or by the light tree where the scene has one (light_tree.wgsl),
+// then a direction towards it: quads and triangles by area, spheres by the cone
 // of directions they subtend from outside, and by area from inside (where there is no cone), the
 // environment map by luminance (environment.wgsl), point, spot and directional lights in
 // punctual.wgsl.
@@ -22,6 +23,35 @@ fn pick_emitter(u: f32, u_alias: f32) -> EmitterChoice {
         return EmitterChoice(slot.primitive, slot.index, slot.probability);
     }
     return EmitterChoice(slot.alias_primitive, slot.alias_index, slot.alias_probability);
+}
+
+// The light tree's choice in place of the alias table's `e` (picked with u_slot): where every
+// emitter is finite, the tree picks with u_slot itself; otherwise the alias table's choice
+// between the infinite lights (kept as it is) and the finite ones stands, and the tree picks
+// among those with one more number. Probability 0 where no finite emitter can light p.
+fn tree_choice(p: vec3<f32>, u_slot: f32, e: EmitterChoice, rng: ptr<function, Rng>) -> EmitterChoice {
+    var u = u_slot;
+    if params.light_tree_probability < 1.0 {
+        var infinite = emitter_is_environment(e.primitive);
+        if emitter_is_light(e.primitive) {
+            infinite = lights[e.index].kind == LIGHT_SUN;
+        }
+        if infinite {
+            return e;
+        }
+        u = rng_next(rng);
+    }
+    let c = light_tree_pick(p, u);
+    return EmitterChoice(c.primitive, c.index, params.light_tree_probability * c.probability);
+}
+
+// The probability that next-event estimation at p picks the emitting sphere, quad or triangle
+// (primitive, index), whose probability by power is by_power.
+fn selection_probability(p: vec3<f32>, primitive: u32, index: u32, by_power: f32) -> f32 {
+    if light_tree_active() {
+        return light_tree_selection_probability(p, primitive, index);
+    }
+    return by_power;
 }
 
 // Whether an emitter is a point, spot or directional light (punctual.wgsl); checked first.
@@ -106,8 +136,14 @@ fn sample_light(p: vec3<f32>, probe: vec3<f32>, rng: ptr<function, Rng>) -> Ligh
     }
     let u_slot = rng_next(rng);
     let u_alias = rng_next(rng);
-    let e = pick_emitter(u_slot, u_alias);
+    var e = pick_emitter(u_slot, u_alias);
     let u = vec2<f32>(rng_next(rng), rng_next(rng));
+    if light_tree_active() {
+        e = tree_choice(p, u_slot, e, rng);
+        if !(e.probability > 0.0) {
+            return out;
+        }
+    }
     out.primitive = e.primitive;
     out.index = e.index;
     out.is_delta = false;
@@ -197,7 +233,8 @@ fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, ind
         if !(t > 0.0) {
             return 0.0;
         }
-        return tri.light_probability * area_to_solid_angle(t, dot(normal, dir), tri.area);
+        let chosen = selection_probability(p, primitive, index, tri.light_probability);
+        return chosen * area_to_solid_angle(t, dot(normal, dir), tri.area);
     }
     if emitter_is_quad(primitive) {
         let q = quads[index];
@@ -206,17 +243,19 @@ fn light_pdf(p: vec3<f32>, probe: vec3<f32>, dir: vec3<f32>, primitive: u32, ind
         if !(t > 0.0) {
             return 0.0;
         }
-        return q.light_probability * area_to_solid_angle(t, cos_light, q.area);
+        let chosen = selection_probability(p, primitive, index, q.light_probability);
+        return chosen * area_to_solid_angle(t, cos_light, q.area);
     }
     let s = spheres[index];
+    let chosen = selection_probability(p, primitive, index, s.light_probability);
     if sphere_contains(s, probe) {
         let chord = sphere_chord(s, p, dir);
         if !(chord.t > 0.0) {
             return 0.0;
         }
-        return s.light_probability * area_to_solid_angle(chord.t, chord.cos_exit, 4.0 * PI * s.radius * s.radius);
+        return chosen * area_to_solid_angle(chord.t, chord.cos_exit, 4.0 * PI * s.radius * s.radius);
     }
-    return s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p));
+    return chosen / (2.0 * PI * cone_one_minus_cos(s, p));
 }
 
 // Whether a shadow ray along a light sample reaches the light it sampled.

@@ -21,7 +21,8 @@ use crate::render::{
 use crate::scene::model::ModelScene;
 use crate::scene::model_toml::model_toml;
 use crate::scene::{
-    Integrator, RenderOverrides, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+    Integrator, LightSampler, RenderOverrides, Sampler, Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE,
+    MAX_SPP,
 };
 use anyhow::Result;
 use clap::Args;
@@ -63,6 +64,11 @@ pub struct RenderArgs {
     /// independent): independent numbers, or Owen-scrambled Sobol points (lower error).
     #[arg(long, value_enum)]
     pub sampler: Option<Sampler>,
+    /// How path tracing's next-event estimation picks an emitter (overrides [render]
+    /// light_sampler; default power): a light tree, by each emitter's bound on what it sends
+    /// to the shading point, or an alias table by power alone.
+    #[arg(long, value_enum)]
+    pub light_sampler: Option<LightSampler>,
     /// The light transport estimator (overrides [render] integrator; default path): path
     /// tracing, or bidirectional path tracing (caustics).
     #[arg(long, value_enum)]
@@ -216,6 +222,7 @@ fn scene_to_render(args: &RenderArgs) -> Result<Option<Scene>> {
         light_sampling: args.light_sampling,
         sampler: args.sampler,
         integrator: args.integrator,
+        light_sampler: args.light_sampler,
     };
     let scene = scene
         .with_overrides(&overrides)
@@ -295,6 +302,7 @@ fn json_summary(
         "seed": run.scene.render.seed,
         "sampler": run.scene.render.sampler.name(),
         "integrator": run.scene.render.integrator.name(),
+        "light_sampler": run.scene.render.light_sampler.name(),
         "paths": paths,
         "adaptive": adaptive,
         "seconds": seconds,

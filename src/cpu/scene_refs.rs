@@ -9,8 +9,8 @@ use crate::cpu::media::grid::Grids;
 use crate::cpu::textures::texture::Textures;
 use crate::kernel::bvh::layout::BvhLayout;
 use crate::kernel::types::{
-    Emitter, EnvironmentAlias, EnvironmentTexel, Light, Material, Params, Texture, TriangleColors,
-    TriangleTangents,
+    Emitter, EnvironmentAlias, EnvironmentTexel, Light, LightTreeNode, Material, Params, Texture,
+    TriangleColors, TriangleTangents,
 };
 use crate::kernel::variant::has_alpha;
 use crate::kernel::KernelScene;
@@ -35,6 +35,9 @@ pub struct SceneRefs<'a> {
     pub lights: &'a [Light],
     /// Grid media's grids (`src/cpu/media/grid.rs`); empty without them.
     pub grids: Grids<'a>,
+    /// The light tree and its trails (`src/cpu/lights/light_tree.rs`); empty without one.
+    pub light_tree_nodes: &'a [LightTreeNode],
+    pub light_tree_trails: &'a [[u32; 2]],
     /// The surfaces, as intersection reads them: spheres, quads, triangles with their normals
     /// and texture coordinates, the BVHs and instances, and the key of the ray segment being
     /// traced (the kernel's private `alpha_key`), which `path_step` sets when `has_alpha`.
@@ -65,6 +68,8 @@ impl<'a> SceneRefs<'a> {
                 grids: &scene.grids,
                 voxels: &scene.grid_voxels,
             },
+            light_tree_nodes: &scene.light_tree_nodes,
+            light_tree_trails: &scene.light_tree_trails,
             geometry: Geometry {
                 spheres: &scene.spheres,
                 quads: &scene.quads,

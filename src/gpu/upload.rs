@@ -120,6 +120,8 @@ pub struct SceneBuffers {
     environment_texels: wgpu::Buffer,
     environment_alias: wgpu::Buffer,
     lights: wgpu::Buffer,
+    light_tree_nodes: wgpu::Buffer,
+    light_tree_trails: wgpu::Buffer,
     ggx_energy: wgpu::Buffer,
     dielectric_energy: wgpu::Buffer,
     sheen_energy: wgpu::Buffer,
@@ -130,6 +132,8 @@ pub struct SceneBuffers {
     /// only.
     grids: Option<(wgpu::Buffer, wgpu::Buffer)>,
     pub texel_binding: TexelBinding,
+    /// Whether the kernel declares the light tree's bindings (48 and 49).
+    light_tree: bool,
 }
 
 /// The tree each variant binds: the wide one where the variant traverses it, the binary one
@@ -248,6 +252,8 @@ impl SceneBuffers {
                 &scene.environment_alias,
             ),
             lights: storage_buffer(ctx, "lights", &scene.lights),
+            light_tree_nodes: storage_buffer(ctx, "light tree", &scene.light_tree_nodes),
+            light_tree_trails: storage_buffer(ctx, "light tree trails", &scene.light_tree_trails),
             // The PBR material's energy tables (src/tables/), placeholders where the kernel
             // does not read them.
             ggx_energy: energy_table(
@@ -277,6 +283,7 @@ impl SceneBuffers {
             wide,
             grids,
             texel_binding,
+            light_tree: features.light_tree,
         })
     }
 
@@ -357,6 +364,16 @@ impl SceneBuffers {
                     read_only,
                 ),
                 BufferNeed::new("lights", array_bytes(&scene.lights), read_only),
+                BufferNeed::new(
+                    "light tree",
+                    array_bytes(&scene.light_tree_nodes),
+                    read_only,
+                ),
+                BufferNeed::new(
+                    "light tree trails",
+                    array_bytes(&scene.light_tree_trails),
+                    read_only,
+                ),
                 BufferNeed::new("grid media", array_bytes(&scene.grids), read_only),
                 BufferNeed::new(
                     "grid media voxels",
@@ -413,6 +430,10 @@ impl SceneBuffers {
         if let Some((nodes, top)) = &self.wide {
             bindings.push((44, READ_ONLY, nodes));
             bindings.push((45, UNIFORM, top));
+        }
+        if self.light_tree {
+            bindings.push((48, READ_ONLY, &self.light_tree_nodes));
+            bindings.push((49, READ_ONLY, &self.light_tree_trails));
         }
         if let Some((grids, voxels)) = &self.grids {
             bindings.push((46, READ_ONLY, grids));

@@ -7,7 +7,7 @@ use crate::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding};
 
 /// The kernel's parts in dependency order, with their file names, for error messages and tests.
 /// The scene's bindings come between `types.wgsl` and the rest: see [`SceneBinding`].
-pub const SHADER_PARTS: [(&str, &str); 47] = [
+pub const SHADER_PARTS: [(&str, &str); 48] = [
     (
         "core/types.wgsl",
         include_str!("../../shaders/core/types.wgsl"),
@@ -150,6 +150,10 @@ pub const SHADER_PARTS: [(&str, &str); 47] = [
         include_str!("../../shaders/lights/light_sample.wgsl"),
     ),
     (
+        "lights/light_tree.wgsl",
+        include_str!("../../shaders/lights/light_tree.wgsl"),
+    ),
+    (
         "lights/sampling.wgsl",
         include_str!("../../shaders/lights/sampling.wgsl"),
     ),
@@ -257,6 +261,13 @@ const NO_GRID_MEDIA: (&str, &str) = (
     include_str!("../../shaders/media/no_grid.wgsl"),
 );
 
+/// What stands in for lights/light_tree.wgsl in kernels without a light tree: what
+/// lights/sampling.wgsl names, never reached (`light_tree_active` is false).
+const NO_LIGHT_TREE: (&str, &str) = (
+    "lights/no_light_tree.wgsl",
+    include_str!("../../shaders/lights/no_light_tree.wgsl"),
+);
+
 /// Name of the compute entry point in `shaders/integrator/path.wgsl`.
 pub const RENDER_ENTRY_POINT: &str = "render";
 
@@ -341,7 +352,8 @@ fn features_part(features: &KernelFeatures) -> String {
          const HAS_LIGHTS: bool = {};\nconst HAS_SUN_DISKS: bool = {};\n\
          const HAS_ALPHA: bool = {};\nconst HAS_VERTEX_COLORS: bool = {};\n\
          const HAS_TEXCOORD_1: bool = {};\nconst HAS_INSTANCES: bool = {};\n\
-         const HAS_MEDIA: bool = {};\nconst HAS_GRID_MEDIA: bool = {};\n",
+         const HAS_MEDIA: bool = {};\nconst HAS_GRID_MEDIA: bool = {};\n\
+         const HAS_LIGHT_TREE: bool = {};\n",
         features.light_sampling,
         features.sphere_emitters,
         features.quad_emitters,
@@ -363,7 +375,8 @@ fn features_part(features: &KernelFeatures) -> String {
         features.textures && features.texcoord1,
         features.instances,
         features.media,
-        features.media && features.grid_media
+        features.media && features.grid_media,
+        features.light_tree
     )
 }
 
@@ -421,7 +434,13 @@ pub fn render_kernel_source_with_texels(
     };
     for (i, &(name, text)) in SHADER_PARTS.iter().chain(bdpt_parts).enumerate() {
         // Without media, the stubs take the media's parts' place (medium.wgsl's).
-        let (name, text) = if name == "media/grid.wgsl" {
+        let (name, text) = if name == "lights/light_tree.wgsl" {
+            if variant.features.light_tree {
+                (name, text)
+            } else {
+                NO_LIGHT_TREE
+            }
+        } else if name == "media/grid.wgsl" {
             if !variant.features.media {
                 continue;
             }

@@ -73,6 +73,14 @@ pub struct Params {
     pub camera_medium: u32,
     pub _pad: u32,
     pub media: [Medium; MAX_MEDIUM_SLOTS],
+    /// Nodes of the light tree next-event estimation picks finite emitters with
+    /// (`KernelScene::light_tree_nodes`, `src/cpu/lights/light_tree.rs`); 0: none, the alias
+    /// table by power picks them.
+    pub light_tree_nodes: u32,
+    /// The probability that light sampling picks a finite emitter (one in the tree) rather
+    /// than the environment map or a sun, which keep their own probabilities.
+    pub light_tree_probability: f32,
+    pub _pad_tree: [u32; 2],
 }
 
 /// The media's slots in `Params` (`crate::scene::medium::MAX_MEDIUM_SLOTS`).
@@ -267,6 +275,26 @@ pub struct Emitter {
 }
 
 pub const PRIMITIVE_TRIANGLE: u32 = 2;
+
+/// A node of the light tree (Conty Estevez and Kulla 2018, pbrt-v4's `LightBounds`): the box
+/// around its emitters, their summed power `phi`, and the cone bounding their normals (axis,
+/// cos θo) and how far from a normal they emit (cos θe); `two_sided` (0 or 1) where any of them
+/// emits from both sides. An interior node's first child follows it and `child` is its second;
+/// a leaf has `child` 0 and holds one emitter (`primitive`, `index`, as in `Emitter`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LightTreeNode {
+    pub lo: [f32; 3],
+    pub phi: f32,
+    pub hi: [f32; 3],
+    pub cos_theta_o: f32,
+    pub axis: [f32; 3],
+    pub cos_theta_e: f32,
+    pub child: u32,
+    pub primitive: u32,
+    pub index: u32,
+    pub two_sided: u32,
+}
 
 /// A mesh triangle: what intersection and light sampling read (48 bytes, so a BVH leaf's
 /// triangles stay compact). Its unit normal is `normalize((v1 − v0) × (v2 − v0))`.

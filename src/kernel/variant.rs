@@ -239,6 +239,10 @@ pub struct KernelFeatures {
     /// next-event estimation and light paths reach every emitter, light sampling or not, so
     /// [`KernelFeatures::of`] compiles the lights in wherever the scene has them.
     pub bdpt: bool,
+    /// The light tree (shaders/lights/light_tree.wgsl), for scenes whose next-event
+    /// estimation picks emitters with one (`Params::light_tree_nodes`); a stub stands in
+    /// elsewhere, so scenes picking by power compile what they did before.
+    pub light_tree: bool,
 }
 
 impl KernelFeatures {
@@ -267,6 +271,7 @@ impl KernelFeatures {
         media: true,
         grid_media: true,
         bdpt: true,
+        light_tree: true,
     };
 
     /// What `scene`, rendered with its own `Params`, can reach.
@@ -311,6 +316,7 @@ impl KernelFeatures {
             media: scene.params.medium_count > 0,
             grid_media: scene.params.medium_count > 0 && !scene.grids.is_empty(),
             bdpt,
+            light_tree: light_sampling && scene.params.light_tree_nodes > 0 && !bdpt,
         }
     }
 
@@ -341,6 +347,7 @@ impl KernelFeatures {
             media: self.media || other.media,
             grid_media: self.grid_media || other.grid_media,
             bdpt: self.bdpt || other.bdpt,
+            light_tree: self.light_tree || other.light_tree,
         }
     }
 
@@ -370,6 +377,7 @@ impl KernelFeatures {
             && needs(self.media, other.media)
             && needs(self.grid_media, other.grid_media)
             && needs(self.bdpt, other.bdpt)
+            && needs(self.light_tree, other.light_tree)
     }
 }
 

@@ -115,6 +115,8 @@ pub fn settings_hash(scene: &KernelScene) -> String {
         instances,
         grids,
         grid_voxels,
+        light_tree_nodes,
+        light_tree_trails,
     } = scene;
     let mut params = *params;
     params.sample_start = 0;
@@ -155,7 +157,8 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     // And the media, where there are any.
     if params.medium_count != 0 {
         let start = std::mem::offset_of!(Params, medium_count);
-        array("media", &bytemuck::bytes_of(&params)[start..]);
+        let end = std::mem::offset_of!(Params, light_tree_nodes);
+        array("media", &bytemuck::bytes_of(&params)[start..end]);
     }
     array("spheres", bytemuck::cast_slice(spheres));
     array("quads", bytemuck::cast_slice(quads));
@@ -188,6 +191,15 @@ pub fn settings_hash(scene: &KernelScene) -> String {
     if !grids.is_empty() {
         array("grids", bytemuck::cast_slice(grids));
         array("grid voxels", bytemuck::cast_slice(grid_voxels));
+    }
+    // The light tree, where next-event estimation picks with one.
+    if !light_tree_nodes.is_empty() {
+        array(
+            "light tree probability",
+            bytemuck::bytes_of(&params.light_tree_probability),
+        );
+        array("light tree", bytemuck::cast_slice(light_tree_nodes));
+        array("light tree trails", bytemuck::cast_slice(light_tree_trails));
     }
     let mut hex = String::with_capacity(64);
     for byte in hasher.finalize() {

@@ -136,6 +136,7 @@ pub(super) struct RenderToml {
     pub(super) light_sampling: Option<bool>,
     pub(super) russian_roulette: Option<bool>,
     pub(super) sampler: Option<S<String>>,
+    pub(super) light_sampler: Option<S<String>>,
     pub(super) integrator: Option<S<String>>,
     /// The medium that fills the scene outside every object (fog).
     pub(super) medium: Option<S<String>>,

@@ -209,6 +209,39 @@ pub struct RenderSettings {
     pub sampler: Sampler,
     /// Which estimator renders the image.
     pub integrator: Integrator,
+    /// How next-event estimation picks an emitter.
+    pub light_sampler: LightSampler,
+}
+
+/// `[render] light_sampler`, `--light-sampler`: how path tracing's next-event estimation
+/// picks the emitter to sample (bidirectional path tracing always picks by power).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum LightSampler {
+    /// A light tree (Conty Estevez and Kulla 2018, pbrt-v4's BVHLightSampler): emitters in
+    /// proportion to a bound on what each sends to the shading point, from its power,
+    /// distance and orientation; the environment map and suns keep their power share.
+    Tree,
+    /// In proportion to power alone, by the alias table: O(1), blind to where the shading
+    /// point is.
+    #[default]
+    Power,
+}
+
+impl LightSampler {
+    pub fn name(self) -> &'static str {
+        match self {
+            LightSampler::Tree => "tree",
+            LightSampler::Power => "power",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<LightSampler> {
+        match name {
+            "tree" => Some(LightSampler::Tree),
+            "power" => Some(LightSampler::Power),
+            _ => None,
+        }
+    }
 }
 
 /// `[render] integrator`, `--integrator`: the light transport estimator.
@@ -462,6 +495,7 @@ pub struct RenderOverrides {
     pub light_sampling: Option<bool>,
     pub sampler: Option<Sampler>,
     pub integrator: Option<Integrator>,
+    pub light_sampler: Option<LightSampler>,
 }
 
 impl Scene {
@@ -542,6 +576,7 @@ impl Scene {
         r.light_sampling = o.light_sampling.unwrap_or(r.light_sampling);
         r.sampler = o.sampler.unwrap_or(r.sampler);
         r.integrator = o.integrator.unwrap_or(r.integrator);
+        r.light_sampler = o.light_sampler.unwrap_or(r.light_sampler);
         check_image_size(r.width as i64, r.height as i64)?;
         check_range(r.spp as i64, 1, MAX_SPP as i64).map_err(|m| format!("spp {m}"))?;
         check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)

@@ -222,6 +222,7 @@ pub fn load_model(path: &Path, options: &ModelOptions) -> Result<ModelScene, Sce
             russian_roulette: true,
             sampler: Default::default(),
             integrator: Default::default(),
+            light_sampler: Default::default(),
         },
         materials,
         spheres: Vec::new(),

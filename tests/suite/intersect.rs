@@ -49,6 +49,7 @@ fn quad(corner: [f32; 3], u: [f32; 3], v: [f32; 3]) -> Quad {
             russian_roulette: true,
             sampler: Default::default(),
             integrator: Default::default(),
+            light_sampler: Default::default(),
         },
         materials: vec![Material {
             name: "m".into(),

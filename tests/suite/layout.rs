@@ -10,8 +10,8 @@ use glint::kernel::source::{
 use glint::kernel::texels::{TexelBinding, EXTRA_WINDOW_BINDINGS, TEXEL_BYTES};
 use glint::kernel::types::{
     BvhNode, BvhWideNode, Emitter, EnvironmentAlias, EnvironmentTexel, GridMedium, Instance, Light,
-    Material, Medium, Params, Quad, Sphere, Texture, Triangle, TriangleColors, TriangleNormals,
-    TriangleTangents, TriangleUvs,
+    LightTreeNode, Material, Medium, Params, Quad, Sphere, Texture, Triangle, TriangleColors,
+    TriangleNormals, TriangleTangents, TriangleUvs,
 };
 use glint::kernel::variant::{KernelFeatures, KernelVariant, SceneBinding, SceneCounts};
 use naga::proc::Layouter;
@@ -126,7 +126,26 @@ fn rust_structs_match_wgsl_layout() {
             medium_count,
             global_medium,
             camera_medium,
-            media
+            media,
+            light_tree_nodes,
+            light_tree_probability
+        ]
+    );
+    assert_same_layout!(
+        &module,
+        LightTreeNode,
+        "LightTreeNode",
+        [
+            lo,
+            phi,
+            hi,
+            cos_theta_o,
+            axis,
+            cos_theta_e,
+            child,
+            primitive,
+            index,
+            two_sided
         ]
     );
     assert_same_layout!(
@@ -498,6 +517,32 @@ fn kernels_without_grid_media_carry_only_the_grid_stub() {
     assert!(!with.contains("// ---- media/no_grid.wgsl"));
 }
 
+/// Kernels of scenes picking emitters by power carry the light tree's stubs, not the tree nor
+/// its bindings.
+#[test]
+fn kernels_without_a_light_tree_carry_only_its_stubs() {
+    let source = |light_tree| {
+        render_kernel_source_for(KernelVariant {
+            binding: SceneBinding::Storage,
+            features: KernelFeatures {
+                light_tree,
+                ..KernelFeatures::ALL
+            },
+        })
+    };
+    let (with, without) = (source(true), source(false));
+    for part in [
+        "// ---- lights/light_tree.wgsl",
+        "fn node_importance(",
+        "var<storage, read> light_tree_nodes",
+    ] {
+        assert!(with.contains(part), "{part} missing with the tree");
+        assert!(!without.contains(part), "{part} present without the tree");
+    }
+    assert!(without.contains("// ---- lights/no_light_tree.wgsl"));
+    assert!(!with.contains("// ---- lights/no_light_tree.wgsl"));
+}
+
 /// Every combination of compiled-out features gives a valid kernel, in every binding.
 #[test]
 fn every_feature_combination_validates() {
@@ -545,6 +590,8 @@ fn every_feature_combination_validates() {
             grid_media: (bits * 29 / 19) % 2 == 1,
             // Likewise, with and without lights, the environment, textures and triangles.
             bdpt: (bits * 23 / 17) % 2 == 1,
+            // Likewise, with and without each kind of emitter and lights.
+            light_tree: (bits * 31 / 23) % 2 == 1,
         };
         for binding in [
             SceneBinding::Storage,
@@ -595,6 +642,7 @@ fn hardware_variant_validates_and_only_it_uses_ray_queries() {
         media: false,
         grid_media: false,
         bdpt: false,
+        light_tree: false,
     };
     for features in [KernelFeatures::ALL, none] {
         let source = render_kernel_source_for(KernelVariant {

@@ -54,6 +54,7 @@ mod closed_form;
 mod environment;
 mod gpu_vs_cpu;
 mod grid_media;
+mod light_tree;
 mod lights;
 mod media;
 mod sampling;

@@ -1,5 +1,6 @@
 //! Light sampling for next-event estimation (WGSL side: `shaders/lights/sampling.wgsl`). An emitter is
-//! chosen in proportion to its power, then a direction towards it: quads and triangles by area, spheres by
+//! chosen in proportion to its power, or by the light tree where the scene has one
+//! (`light_tree.rs`), then a direction towards it: quads and triangles by area, spheres by
 //! the cone of directions they subtend from outside, and by area from inside, the environment
 //! map by luminance (`environment.rs`), point, spot and directional lights in `punctual.rs`.
 //! All pdfs are per
@@ -14,12 +15,14 @@ use crate::cpu::geometry::triangle::{
 };
 use crate::cpu::lights::environment::{environment_pdf, sample_environment};
 use crate::cpu::lights::light_sample::LightSample;
+use crate::cpu::lights::light_tree::{light_tree_active, tree_pick, tree_selection_probability};
 use crate::cpu::lights::punctual::{punctual_visible, sample_punctual};
 use crate::cpu::scene_refs::SceneRefs;
 use crate::cpu::textures::texture::{emission_at, triangle_uv};
 use crate::cpu::textures::vertex_color::vertex_colored_emission;
 use crate::kernel::types::{
-    Sphere, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
+    Sphere, LIGHT_SUN, NO_TEXTURE, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD,
+    PRIMITIVE_TRIANGLE,
 };
 use glam::Vec3;
 
@@ -49,6 +52,51 @@ pub fn pick_emitter(scene: &SceneRefs, u: f32, u_alias: f32) -> EmitterChoice {
         index: slot.alias_index,
         probability: slot.alias_probability,
     }
+}
+
+/// The light tree's choice in place of the alias table's `e` (picked with `u_slot`): where
+/// every emitter is finite, the tree picks with `u_slot` itself; otherwise the alias table's
+/// choice between the infinite lights (kept as it is) and the finite ones stands, and the tree
+/// picks among those with one more number. `None` where no finite emitter can light `p`.
+fn tree_choice(
+    scene: &SceneRefs,
+    p: Vec3,
+    u_slot: f32,
+    e: EmitterChoice,
+    rng: &mut Rng,
+) -> Option<EmitterChoice> {
+    let params = scene.params;
+    let u = if params.light_tree_probability >= 1.0 {
+        u_slot
+    } else {
+        let infinite = e.primitive == PRIMITIVE_ENVIRONMENT
+            || (e.primitive == PRIMITIVE_LIGHT && scene.lights[e.index as usize].kind == LIGHT_SUN);
+        if infinite {
+            return Some(e);
+        }
+        rng.next_f32()
+    };
+    let (primitive, index, pmf) = tree_pick(scene.light_tree_nodes, p, u)?;
+    Some(EmitterChoice {
+        primitive,
+        index,
+        probability: params.light_tree_probability * pmf,
+    })
+}
+
+/// The probability that next-event estimation at `p` picks the emitting sphere, quad or
+/// triangle (primitive, index), whose probability by power is `by_power`.
+fn selection_probability(
+    scene: &SceneRefs,
+    p: Vec3,
+    primitive: u32,
+    index: u32,
+    by_power: f32,
+) -> f32 {
+    if light_tree_active(scene.params) {
+        return tree_selection_probability(scene, p, primitive, index);
+    }
+    by_power
 }
 
 pub fn sphere_contains(s: &Sphere, p: Vec3) -> bool {
@@ -98,8 +146,14 @@ pub fn sample_light(scene: &SceneRefs, p: Vec3, probe: Vec3, rng: &mut Rng) -> L
         return out;
     }
     let (u_slot, u_alias) = (rng.next_f32(), rng.next_f32());
-    let e = pick_emitter(scene, u_slot, u_alias);
+    let mut e = pick_emitter(scene, u_slot, u_alias);
     let u = (rng.next_f32(), rng.next_f32());
+    if light_tree_active(scene.params) {
+        match tree_choice(scene, p, u_slot, e, rng) {
+            Some(choice) => e = choice,
+            None => return out,
+        }
+    }
     out.primitive = e.primitive;
     out.index = e.index;
     if e.primitive == PRIMITIVE_LIGHT {
@@ -207,7 +261,8 @@ pub fn light_pdf(
         if !(t > 0.0) {
             return 0.0;
         }
-        return tri.light_probability * area_to_solid_angle(t, normal.dot(dir), tri.area);
+        let chosen = selection_probability(scene, p, primitive, index, tri.light_probability);
+        return chosen * area_to_solid_angle(t, normal.dot(dir), tri.area);
     }
     if primitive == PRIMITIVE_QUAD {
         let q = &scene.geometry.quads[index as usize];
@@ -218,19 +273,20 @@ pub fn light_pdf(
         if !(t > 0.0) {
             return 0.0;
         }
-        return q.light_probability * area_to_solid_angle(t, cos_light, q.area);
+        let chosen = selection_probability(scene, p, primitive, index, q.light_probability);
+        return chosen * area_to_solid_angle(t, cos_light, q.area);
     }
     let s = &scene.geometry.spheres[index as usize];
+    let chosen = selection_probability(scene, p, primitive, index, s.light_probability);
     if sphere_contains(s, probe) {
         let (t, cos_exit) = sphere_chord(s, p, dir);
         #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(t > 0.0) {
             return 0.0;
         }
-        return s.light_probability
-            * area_to_solid_angle(t, cos_exit, 4.0 * PI * s.radius * s.radius);
+        return chosen * area_to_solid_angle(t, cos_exit, 4.0 * PI * s.radius * s.radius);
     }
-    s.light_probability / (2.0 * PI * cone_one_minus_cos(s, p))
+    chosen / (2.0 * PI * cone_one_minus_cos(s, p))
 }
 
 /// Whether a shadow ray along a light sample reaches the light it sampled.

@@ -16,7 +16,7 @@ use glam::{Vec2, Vec3};
 
 /// An emitter before the table: its primitive kind (`PRIMITIVE_*`), its index among those,
 /// and its power (above 0).
-type Power = (u32, u32, f64);
+pub(super) type Power = (u32, u32, f64);
 
 /// The emitters (light sampling's alias table), and the probability of picking each sphere,
 /// quad, triangle and light (0 for those that do not emit).
@@ -26,6 +26,11 @@ pub(super) struct EmitterTable {
     pub(super) quad_probability: Vec<f32>,
     pub(super) triangle_probability: Vec<f32>,
     pub(super) light_probability: Vec<f32>,
+    /// The finite emitters' powers (all but the environment map and suns): what the light
+    /// tree is built over (`light_tree.rs`).
+    pub(super) finite: Vec<Power>,
+    /// The probability of picking one of them.
+    pub(super) finite_probability: f32,
 }
 
 impl Scene {
@@ -58,13 +63,34 @@ impl Scene {
                 powers.push((PRIMITIVE_LIGHT, i as u32, power));
             }
         }
+        let finite: Vec<Power> = powers
+            .iter()
+            .copied()
+            .filter(|&(primitive, index, _)| match primitive {
+                PRIMITIVE_ENVIRONMENT => false,
+                PRIMITIVE_LIGHT => !matches!(
+                    self.lights[index as usize].kind,
+                    LightKind::Directional { .. }
+                ),
+                _ => true,
+            })
+            .collect();
+        let total: f64 = powers.iter().map(|p| p.2).sum();
+        let finite_power: f64 = finite.iter().map(|p| p.2).sum();
         let emitters = alias_table(&powers);
-        self.per_primitive_probabilities(emitters)
+        let mut table = self.per_primitive_probabilities(emitters);
+        table.finite_probability = if finite_power == total {
+            1.0
+        } else {
+            (finite_power / total) as f32
+        };
+        table.finite = finite;
+        table
     }
 
     /// The emitting spheres, quads and triangles (the scene's own: instanced meshes never
     /// emit), in that order, with their powers.
-    fn primitive_powers(&self) -> Vec<Power> {
+    pub(super) fn primitive_powers(&self) -> Vec<Power> {
         let radiance = |material: u32| self.materials[material as usize].emitted_radiance;
         let mut powers: Vec<Power> = Vec::new();
         for (i, s) in self.spheres.iter().enumerate() {
@@ -192,6 +218,8 @@ impl Scene {
             quad_probability,
             triangle_probability,
             light_probability,
+            finite: Vec::new(),
+            finite_probability: 0.0,
         }
     }
 }

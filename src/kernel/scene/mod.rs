@@ -7,9 +7,11 @@ mod acceleration;
 mod emitter_table;
 mod geometry;
 mod grids;
+mod light_tree;
 mod materials;
 mod params;
 
+pub use light_tree::MAX_TREE_EMITTERS;
 pub use params::place_camera;
 
 use crate::error::InputError;
@@ -66,6 +68,12 @@ pub struct KernelScene {
     /// densities and block majorants (`grids.rs`); empty without grid media.
     pub grids: Vec<types::GridMedium>,
     pub grid_voxels: Vec<f32>,
+    /// The light tree path tracing's next-event estimation picks finite emitters with
+    /// (`light_tree.rs`), `Params::light_tree_nodes` of them, and each emitting sphere's,
+    /// quad's and triangle's path to its leaf, in that order, 64 bits as two words; both
+    /// empty where the alias table picks every emitter.
+    pub light_tree_nodes: Vec<types::LightTreeNode>,
+    pub light_tree_trails: Vec<[u32; 2]>,
 }
 
 impl KernelScene {
@@ -95,6 +103,8 @@ impl KernelScene {
             + bytes(&self.instances)
             + bytes(&self.grids)
             + bytes(&self.grid_voxels)
+            + bytes(&self.light_tree_nodes)
+            + bytes(&self.light_tree_trails)
     }
 }
 
@@ -158,6 +168,8 @@ impl Scene {
             quad_probability,
             triangle_probability,
             light_probability,
+            finite,
+            finite_probability,
         } = self.emitter_table(environment.as_ref().map(|(_, t)| t.radiance_integral));
         let params = self.kernel_params(&emitters, environment.as_ref().map(|(e, _)| *e));
         let (environment_texels, environment_alias) = match environment {
@@ -165,6 +177,15 @@ impl Scene {
             None => (Vec::new(), Vec::new()),
         };
         let (grids, grid_voxels) = grids::kernel_grids(&self.media);
+        // Bidirectional path tracing keeps the choice by power, which its light subpaths
+        // and their MIS weights assume.
+        let tree = if self.render.light_sampler == crate::scene::LightSampler::Tree
+            && self.render.integrator == crate::scene::Integrator::Path
+        {
+            self.light_tree(&finite)
+        } else {
+            light_tree::LightTree::default()
+        };
         let mut scene = KernelScene {
             params,
             spheres: geometry::kernel_spheres(self, &sphere_probability),
@@ -198,7 +219,13 @@ impl Scene {
             instances: Vec::new(),
             grids,
             grid_voxels,
+            light_tree_nodes: tree.nodes,
+            light_tree_trails: tree.trails,
         };
+        scene.params.light_tree_nodes = scene.light_tree_nodes.len() as u32;
+        if !scene.light_tree_nodes.is_empty() {
+            scene.params.light_tree_probability = finite_probability;
+        }
         scene.params.splat_scale = params::splat_scale(&scene);
         self.lay_out_bvh(&mut scene)?;
         Ok(scene)

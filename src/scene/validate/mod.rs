@@ -15,8 +15,8 @@ pub(super) use fields::FieldError;
 use super::file::{RenderToml, SceneToml};
 use super::medium::{Media, MAX_MEDIUM_SLOTS};
 use super::{
-    check_image_size, check_integrator_bounces, Integrator, RenderSettings, Sampler, Scene,
-    MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
+    check_image_size, check_integrator_bounces, Integrator, LightSampler, RenderSettings, Sampler,
+    Scene, MAX_BOUNCES_LIMIT, MAX_IMAGE_SIDE, MAX_SPP,
 };
 use fields::{fail, int_in, non_negative, radiance_in_range};
 use glam::Vec3;
@@ -192,6 +192,20 @@ fn validate_render(
         },
         None => Sampler::default(),
     };
+    let light_sampler = match &render.light_sampler {
+        Some(s) => match LightSampler::from_name(s.get_ref()) {
+            Some(light_sampler) => light_sampler,
+            None => fail(
+                s.span(),
+                "render.light_sampler",
+                format!(
+                    "unknown light sampler {:?}; known: \"tree\", \"power\"",
+                    s.get_ref()
+                ),
+            )?,
+        },
+        None => LightSampler::default(),
+    };
     let integrator = match &render.integrator {
         Some(s) => match Integrator::from_name(s.get_ref()) {
             Some(integrator) => integrator,
@@ -217,6 +231,7 @@ fn validate_render(
         russian_roulette: render.russian_roulette.unwrap_or(true),
         sampler,
         integrator,
+        light_sampler,
     };
     if let Err(message) = check_integrator_bounces(&settings) {
         fail(render.max_bounces.span(), "render.max_bounces", message)?;
