@@ -61,6 +61,7 @@ pub fn model_toml(model: &ModelScene) -> String {
     let _ = writeln!(out, "light_sampling = {}", r.light_sampling);
     let _ = writeln!(out, "russian_roulette = {}", r.russian_roulette);
     let _ = writeln!(out, "sampler = {}", string(r.sampler.name()));
+    let _ = writeln!(out, "light_sampler = {}", string(r.light_sampler.name()));
     let _ = writeln!(out, "integrator = {}", string(r.integrator.name()));
 
     let _ = writeln!(out, "\n[environment]");

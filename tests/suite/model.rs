@@ -415,6 +415,8 @@ fn print_scene_round_trips() {
             "24",
             "--max-bounces",
             "3",
+            "--light-sampler",
+            "tree",
         ],
     );
     assert_round_trip(&ply, &["--width", "32", "--height", "24"]);
