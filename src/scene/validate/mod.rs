@@ -93,12 +93,6 @@ impl SceneToml {
                 ),
             ));
         }
-        if settings.integrator == Integrator::Bdpt && !media.list.is_empty() {
-            return Err(whole(
-                "render.integrator",
-                "the bdpt integrator does not render participating media yet; use \"path\"".into(),
-            ));
-        }
         let mut warnings = objects.warnings;
         warnings.extend(media::downsampling_warnings(&media));
         let environment = match &self.environment {
