@@ -203,6 +203,30 @@ fn each_strategy_alone_estimates_the_same_light_through_fog() {
     );
 }
 
+/// Density grids with bdpt are refused by name: in grid_media.rs's smooth blob under a sun
+/// and a sky, bdpt came out 12% brighter than path tracing (cause not found yet).
+#[test]
+fn bdpt_refuses_density_grids_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("grid.vdb"),
+        common::vdb::write_vdb(&[crate::grid_media::smooth_grid()]),
+    )
+    .unwrap();
+    let toml = "[camera]\neye = [0.0, 0.0, -4.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 40\n\
+        [render]\nwidth = 4\nheight = 4\nspp = 1\nmax_bounces = 4\nintegrator = \"bdpt\"\n[media.smoke]\ngrid = \"grid.vdb\"\ncolor = [0.9, 0.8, 0.6]\ndensity = 8.0\n\
+        [[volumes]]\nmedium = \"smoke\"\nscale = 0.1\n\
+        [[lights]]\ntype = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nintensity = 3.0\n";
+    let Err(err) = glint::scene::Scene::parse(toml, &dir.path().join("scene.toml")) else {
+        panic!("a density grid with bdpt was accepted");
+    };
+    let err = err.to_string();
+    assert!(
+        err.contains("does not render density-grid media yet"),
+        "{err}"
+    );
+}
+
 /// The kernel's bidirectional integrator has no medium vertices: a scene with media is
 /// refused by name before any kernel is compiled (no kernel variant is added for it).
 #[test]
