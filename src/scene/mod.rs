@@ -582,11 +582,6 @@ impl Scene {
         check_range(r.max_bounces as i64, 0, MAX_BOUNCES_LIMIT as i64)
             .map_err(|m| format!("max_bounces {m}"))?;
         check_integrator_bounces(r)?;
-        if r.integrator == Integrator::Bdpt && !self.media.is_empty() {
-            return Err(
-                "the bdpt integrator does not render participating media yet; use \"path\"".into(),
-            );
-        }
         Ok(self)
     }
 }

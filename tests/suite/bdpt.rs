@@ -32,19 +32,19 @@ use glint::render::accumulation::Accumulation;
 use glint::render::batch_means::BatchMeans;
 use glint::render::Renderer;
 
-const BATCHES: u32 = 16;
+pub(crate) const BATCHES: u32 = 16;
 const MIN_PASS_RATE: f64 = 0.95;
 const MAX_Z_OF_MEANS: f64 = 4.0;
 
 /// A renderer for a scene: the CPU reference, or the GPU kernel.
-type MakeRenderer<'a> = &'a dyn Fn(&KernelScene) -> Box<dyn Renderer + 'a>;
+pub(crate) type MakeRenderer<'a> = &'a dyn Fn(&KernelScene) -> Box<dyn Renderer + 'a>;
 
-fn cpu_renderer(scene: &KernelScene) -> Box<dyn Renderer> {
+pub(crate) fn cpu_renderer(scene: &KernelScene) -> Box<dyn Renderer> {
     Box::new(CpuRenderer::new(scene))
 }
 
 /// Mean and variance-of-the-mean images from `BATCHES` renders of `spp` each, seeds 1, 2, ….
-fn batch_means(
+pub(crate) fn batch_means(
     scene: &KernelScene,
     integrator: u32,
     spp: u32,
@@ -143,7 +143,7 @@ fn bdpt_agrees_with_path_tracing_on_the_shipped_scenes() {
 }
 
 /// The estimate of one strategy alone, or all of them, as an image.
-fn strategy_image(scene: &KernelScene, spp: u32, strategies: Strategies) -> Image {
+pub(crate) fn strategy_image(scene: &KernelScene, spp: u32, strategies: Strategies) -> Image {
     let refs = SceneRefs::of(scene, &scene.params);
     let p = &scene.params;
     let film = SplatFilm::new((p.width * p.height) as usize);
@@ -180,7 +180,7 @@ fn strategy_image(scene: &KernelScene, spp: u32, strategies: Strategies) -> Imag
     }
 }
 
-fn image_mean(image: &Image) -> f64 {
+pub(crate) fn image_mean(image: &Image) -> f64 {
     image
         .pixels
         .iter()
@@ -271,7 +271,7 @@ fn each_strategy_alone_estimates_the_same_light() {
     );
 }
 
-fn render(scene: &KernelScene, batches: &[u32]) -> Accumulation {
+pub(crate) fn render(scene: &KernelScene, batches: &[u32]) -> Accumulation {
     let mut r = CpuRenderer::new(scene);
     for &b in batches {
         r.add_samples(b).unwrap();

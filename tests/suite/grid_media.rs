@@ -74,7 +74,7 @@ intensity = 3.0
 
 /// A smooth grid of 24³ voxels: a Gaussian blob over a low floor, empty where x < 6 (whole
 /// empty majorant blocks for the walk to step over).
-fn smooth_grid() -> VdbGrid {
+pub(crate) fn smooth_grid() -> VdbGrid {
     let mut g = VdbGrid::float("density", [24, 24, 24], |x, y, z| {
         if x < 6 {
             return 0.0;

@@ -49,6 +49,7 @@ mod transmission;
 mod adaptive;
 mod batch_means;
 mod bdpt;
+mod bdpt_media;
 mod chi2;
 mod closed_form;
 mod environment;

@@ -13,14 +13,12 @@ use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::integrator::path::{firefly_clamp, PathState};
 use crate::cpu::lights::light_sample::nee_weight;
 use crate::cpu::lights::sampling::sample_light;
-use crate::cpu::media::grid::grid_free_flight;
 use crate::cpu::media::medium::{
-    current_medium, medium_crossed, sample_free_flight, shadow_transmittance, FreeFlight,
-    TrackingStream,
+    current_medium, medium_crossed, sample_flight, shadow_transmittance, FreeFlight, TrackingStream,
 };
 use crate::cpu::media::phase::{hg_phase, sample_hg};
 use crate::cpu::scene_refs::SceneRefs;
-use crate::kernel::types::{NO_GRID, NO_MEDIUM};
+use crate::kernel::types::NO_MEDIUM;
 use glam::Vec3;
 
 /// The path's ray travels through its medium towards a surface at `t_hit` (`NO_HIT`: none):
@@ -43,13 +41,7 @@ pub fn free_flight(
     }
     let stream = stream_id(path.bounce, PURPOSE_FREE_FLIGHT);
     let mut rng = Rng::with_sampler(pixel, sample, stream, params.seed, params.sampler);
-    let m = &params.media[slot as usize];
-    let flight = if m.grid != NO_GRID {
-        grid_free_flight(scene.grids, m, &path.ray, t_hit, &mut rng)
-    } else {
-        let (u_channel, u_distance) = (rng.next_f32(), rng.next_f32());
-        sample_free_flight(m, t_hit, u_channel, u_distance)
-    };
+    let flight = sample_flight(scene, slot, &path.ray, t_hit, &mut rng);
     path.throughput *= flight.weight;
     flight
 }

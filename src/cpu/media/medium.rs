@@ -16,11 +16,12 @@
 
 use crate::cpu::core::ray::Ray;
 use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_TRACKING};
+use crate::cpu::geometry::hit::Hit;
 use crate::cpu::geometry::hit::NO_HIT;
 use crate::cpu::geometry::intersect::intersect_scene;
 use crate::cpu::geometry::surface::offset_ray_origin;
 use crate::cpu::lights::light_sample::LightSample;
-use crate::cpu::media::grid::grid_transmittance;
+use crate::cpu::media::grid::{grid_free_flight, grid_transmittance};
 use crate::cpu::scene_refs::SceneRefs;
 use crate::kernel::types::{
     Material, Medium, Params, LIGHT_SUN, MATERIAL_DIELECTRIC, NO_GRID, NO_MEDIUM,
@@ -208,6 +209,32 @@ pub fn sample_free_flight(m: &Medium, t_max: f32, u_channel: f32, u_distance: f3
     }
 }
 
+/// A free flight through medium slot `slot` ([`NO_MEDIUM`]: none) along `ray` towards a
+/// surface at `t_hit` (`NO_HIT`: none), from the flight's stream `rng`: delta tracking in a
+/// grid medium, closed form in a homogeneous one. Shared by the path tracer and both of
+/// bidirectional's subpaths.
+pub fn sample_flight(
+    scene: &SceneRefs,
+    slot: u32,
+    ray: &Ray,
+    t_hit: f32,
+    rng: &mut Rng,
+) -> FreeFlight {
+    if slot == NO_MEDIUM {
+        return FreeFlight {
+            t: t_hit,
+            weight: Vec3::ONE,
+            scattered: false,
+        };
+    }
+    let m = &scene.params.media[slot as usize];
+    if m.grid != NO_GRID {
+        return grid_free_flight(scene.grids, m, ray, t_hit, rng);
+    }
+    let (u_channel, u_distance) = (rng.next_f32(), rng.next_f32());
+    sample_free_flight(m, t_hit, u_channel, u_distance)
+}
+
 /// The transmittance from the shadow ray's origin (in the media of `stack`) to the sampled
 /// light: Beer's law over each segment, through interfaces, which change the medium as a path
 /// crossing them would; zero where anything else blocks it. `scene` carries the shadow ray's
@@ -222,6 +249,45 @@ pub fn shadow_transmittance(
     segments: &mut u32,
     tracking: TrackingStream,
 ) -> Vec3 {
+    let end = |ray: &Ray, hit: &Hit| -> f32 {
+        // How far the light is along this ray, if nothing before it blocks it.
+        if light.primitive == PRIMITIVE_ENVIRONMENT {
+            if hit.t == NO_HIT {
+                return NO_HIT;
+            }
+        } else if light.primitive == PRIMITIVE_LIGHT {
+            let l = &scene.lights[light.index as usize];
+            if l.kind == LIGHT_SUN {
+                if hit.t == NO_HIT {
+                    return NO_HIT;
+                }
+            } else {
+                let t = (Vec3::from(l.position) - ray.origin).dot(ray.dir);
+                if hit.t >= t {
+                    return t;
+                }
+            }
+        } else if hit.t != NO_HIT && hit.primitive == light.primitive && hit.index == light.index {
+            return hit.t;
+        }
+        -1.0
+    };
+    transmittance_along(scene, shadow, stack, segments, tracking, end)
+}
+
+/// The transmittance along `shadow` (from media `stack`) to wherever `end` says it ends:
+/// given the ray of the current piece and its first hit, the distance of the end along it, or
+/// a negative number where the hit comes first. Interfaces before the end are crossed (the
+/// stack follows them, as a path's would), anything else blocks. Shared by next-event
+/// estimation's shadow rays and bidirectional's connections.
+pub fn transmittance_along(
+    scene: &SceneRefs,
+    shadow: &Ray,
+    stack: &MediumStack,
+    segments: &mut u32,
+    tracking: TrackingStream,
+    end: impl Fn(&Ray, &Hit) -> f32,
+) -> Vec3 {
     let params = scene.params;
     let mut rng = None;
     let mut ray = *shadow;
@@ -232,30 +298,10 @@ pub fn shadow_transmittance(
             *segments += 1;
         }
         let hit = intersect_scene(&scene.geometry, &ray);
-        // How far the light is along this ray, if nothing before it blocks it.
-        let mut t_light = -1.0;
-        if light.primitive == PRIMITIVE_ENVIRONMENT {
-            if hit.t == NO_HIT {
-                t_light = NO_HIT;
-            }
-        } else if light.primitive == PRIMITIVE_LIGHT {
-            let l = &scene.lights[light.index as usize];
-            if l.kind == LIGHT_SUN {
-                if hit.t == NO_HIT {
-                    t_light = NO_HIT;
-                }
-            } else {
-                let t = (Vec3::from(l.position) - ray.origin).dot(ray.dir);
-                if hit.t >= t {
-                    t_light = t;
-                }
-            }
-        } else if hit.t != NO_HIT && hit.primitive == light.primitive && hit.index == light.index {
-            t_light = hit.t;
-        }
+        let t_end = end(&ray, &hit);
         let slot = current_medium(params, &media);
-        if t_light >= 0.0 {
-            return through * segment_transmittance(scene, slot, &ray, t_light, tracking, &mut rng);
+        if t_end >= 0.0 {
+            return through * segment_transmittance(scene, slot, &ray, t_end, tracking, &mut rng);
         }
         if hit.t == NO_HIT || !is_interface(&scene.materials[hit.material as usize]) {
             return Vec3::ZERO;

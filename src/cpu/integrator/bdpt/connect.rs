@@ -12,6 +12,7 @@
 use crate::cpu::core::camera::{camera_view, CameraView};
 use crate::cpu::core::ray::Ray;
 use crate::cpu::core::rng::{stream_id, Rng, PURPOSE_LIGHT};
+use crate::cpu::geometry::hit::Hit;
 use crate::cpu::geometry::hit::{hit_sphere, NO_HIT};
 use crate::cpu::geometry::intersect::{escapes, unoccluded_before};
 use crate::cpu::geometry::surface::offset_ray_origin;
@@ -28,9 +29,13 @@ use crate::cpu::lights::emission::{
     EMITTER_DELTA_DIRECTION, EMITTER_INFINITE, EMITTER_POINT,
 };
 use crate::cpu::lights::sampling::{light_visible, sample_light, sphere_chord, sphere_contains};
+use crate::cpu::media::medium::{
+    medium_crossed, medium_start, shadow_transmittance, transmittance_along, MediumStack,
+    TrackingStream,
+};
 use crate::cpu::scene_refs::SceneRefs;
 use crate::kernel::types::{
-    LIGHT_SUN, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
+    Params, LIGHT_SUN, PRIMITIVE_ENVIRONMENT, PRIMITIVE_LIGHT, PRIMITIVE_QUAD, PRIMITIVE_TRIANGLE,
     PROJECTION_ORTHOGRAPHIC,
 };
 use glam::Vec3;
@@ -82,6 +87,75 @@ pub fn segment_clear(
     // rounding (measured: 4.5% of the joins from a wall to the floor were lost so).
     unoccluded_before(geometry, &ray, distance * (1.0 - SHADOW_EPSILON))
 }
+
+/// The fraction of the light that gets from camera-side vertex `a` to vertex `b` (one may be
+/// at infinity): 0 or 1 without media (`segment_clear`); with media, the transmittance along
+/// the join, ratio-tracked through grid media as the path tracer's shadow rays are, crossing
+/// interfaces with the medium stack following them. It starts from `a`, whose stack is the
+/// camera subpath's own (so right even where a light subpath's assumed start medium is not).
+pub fn segment_through(
+    scene: &SceneRefs,
+    a: &BdptVertex,
+    b: &BdptVertex,
+    id: SampleId,
+    s: u32,
+    t: u32,
+) -> Vec3 {
+    if scene.params.medium_count == 0 {
+        return if segment_clear(scene, a, b, id, s, t) {
+            Vec3::ONE
+        } else {
+            Vec3::ZERO
+        };
+    }
+    let scene = keyed_connection(scene, id, s, t);
+    let dir = direction_between(a, b);
+    let start = off_surface(a, dir);
+    let media = stack_towards(scene.params, a, dir);
+    let tracking = TrackingStream {
+        pixel: id.pixel,
+        sample: id.sample,
+        bounce: CONNECTION_TRACKING + s * 32 + t,
+    };
+    let mut unused = 0;
+    if b.is_infinite() {
+        let ray = Ray { origin: start, dir };
+        let end = |_: &Ray, hit: &Hit| if hit.t == NO_HIT { NO_HIT } else { -1.0 };
+        return transmittance_along(&scene, &ray, &media, &mut unused, tracking, end);
+    }
+    let end_point = off_surface(b, -dir);
+    let to_end = end_point - start;
+    let distance = to_end.length();
+    if distance <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let ray = Ray {
+        origin: start,
+        dir: to_end / distance,
+    };
+    // As `segment_clear`: short of the far end by a sliver of the join's length.
+    let end = |piece: &Ray, hit: &Hit| {
+        let t_end = (end_point - piece.origin).dot(piece.dir).max(0.0);
+        if hit.t >= t_end - distance * SHADOW_EPSILON {
+            t_end
+        } else {
+            -1.0
+        }
+    };
+    transmittance_along(&scene, &ray, &media, &mut unused, tracking, end)
+}
+
+/// The media a ray from vertex `v` along `dir` starts in: the vertex's, crossed into the
+/// medium its surface bounds where `dir` goes through it.
+fn stack_towards(params: &Params, v: &BdptVertex, dir: Vec3) -> MediumStack {
+    if v.kind == VERTEX_SURFACE && dir.dot(v.hit.normal) < 0.0 {
+        return medium_crossed(params, &v.media, v.hit.material, v.hit.front_face);
+    }
+    v.media
+}
+
+/// The first "bounce" of connections' ratio-tracking streams: above both subpaths'.
+const CONNECTION_TRACKING: u32 = 1 << 17;
 
 /// The fraction of a join's length left unsearched at its far end (pbrt's `ShadowEpsilon`).
 pub const SHADOW_EPSILON: f32 = 1e-4;
@@ -171,17 +245,35 @@ fn direct_light(
     }
     let shadow_scene = keyed_connection(scene, id, 1, t as u32);
     let origin = off_surface(pt, light.dir);
-    if !light_visible(
-        &shadow_scene,
-        &Ray {
-            origin,
-            dir: light.dir,
-        },
-        &light,
-    ) {
+    let shadow = Ray {
+        origin,
+        dir: light.dir,
+    };
+    let mut through = Vec3::ONE;
+    if params.medium_count > 0 {
+        // Through the media as the path tracer's next-event estimation sees them.
+        let media = stack_towards(params, pt, light.dir);
+        let tracking = TrackingStream {
+            pixel: id.pixel,
+            sample: id.sample,
+            bounce: CONNECTION_TRACKING + 32 + t as u32,
+        };
+        let mut unused = 0;
+        through = shadow_transmittance(
+            &shadow_scene,
+            &shadow,
+            &light,
+            &media,
+            &mut unused,
+            tracking,
+        );
+        if through == Vec3::ZERO {
+            return None;
+        }
+    } else if !light_visible(&shadow_scene, &shadow, &light) {
         return None;
     }
-    Some((v, pt.beta * f * light.radiance / light.pdf))
+    Some((v, pt.beta * f * through * light.radiance / light.pdf))
 }
 
 /// Where a ray from `p` along `dir` meets the area emitter (primitive, index): its distance and
@@ -268,7 +360,7 @@ fn unweighted(
     let qs = &light[s - 1];
     if t == 1 {
         // Light tracing: the light vertex seen through the lens.
-        if qs.delta || params.projection == PROJECTION_ORTHOGRAPHIC || qs.kind != VERTEX_SURFACE {
+        if qs.delta || params.projection == PROJECTION_ORTHOGRAPHIC || !qs.scatters() {
             return NOTHING;
         }
         let mut lens_rng = Rng::with_sampler(
@@ -287,6 +379,7 @@ fn unweighted(
         camera_vertex.kind = VERTEX_CAMERA;
         camera_vertex.hit.position = view.lens_point;
         camera_vertex.beta = Vec3::ONE;
+        camera_vertex.media = medium_start(params);
         let to_camera = -view.dir;
         let f_cos = adjoint_f_cos(qs, qs.dir, to_camera);
         if f_cos == Vec3::ZERO {
@@ -295,16 +388,17 @@ fn unweighted(
         // W_e over the lens point's density, times the geometry term, with |cos| at the vertex
         // in f_cos: 1 / (A cos³θ d²), the same for a pinhole and a thin lens.
         let importance = view.pdf_direction / (view.distance * view.distance);
-        if !segment_clear(scene, qs, camera_vertex, id, s as u32, 1) {
+        let through = segment_through(scene, camera_vertex, qs, id, s as u32, 1);
+        if through == Vec3::ZERO {
             return NOTHING;
         }
         return Connection {
-            radiance: qs.beta * f_cos * importance,
+            radiance: qs.beta * f_cos * importance * through,
             view: Some(view),
         };
     }
     let pt = &camera[t - 1];
-    if pt.kind != VERTEX_SURFACE || pt.delta {
+    if !pt.scatters() || pt.delta {
         return NOTHING;
     }
     let to_light = direction_between(pt, qs);
@@ -313,17 +407,18 @@ fn unweighted(
         return NOTHING;
     }
     // s ≥ 2 (s = 1 is next-event estimation's, in `connect`).
-    if qs.delta || qs.kind != VERTEX_SURFACE {
+    if qs.delta || !qs.scatters() {
         return NOTHING;
     }
     let f_qs = adjoint_f_cos(qs, qs.dir, -to_light);
     let d = qs.hit.position - pt.hit.position;
     let radiance = qs.beta * f_qs * f_pt * pt.beta / d.dot(d);
-    if radiance == Vec3::ZERO || !segment_clear(scene, pt, qs, id, s as u32, t as u32) {
+    if radiance == Vec3::ZERO {
         return NOTHING;
     }
+    let through = segment_through(scene, pt, qs, id, s as u32, t as u32);
     Connection {
-        radiance,
+        radiance: radiance * through,
         view: None,
     }
 }
@@ -339,6 +434,15 @@ fn remap0(pdf: f32) -> f32 {
 
 /// The power-heuristic weight of strategy (s, t) for the path it made, against every other
 /// strategy that could have made it. `camera_vertex` is t = 1's lens vertex.
+///
+/// In participating media the densities compared leave out distance sampling, as pbrt-v3's
+/// BDPT does: every strategy samples each segment's free flight (or the transmittance along
+/// a join, which has no density) with the same factors, so leaving them out of every
+/// strategy's density alike keeps the weights summing to 1 for every path, and the densities
+/// stay scalar in chromatic media (one-sample spectral MIS would need a channel-mixture
+/// density per segment instead). Medium vertices contribute their phase function's density,
+/// converted to area measure without a cosine (`to_area_density`). Only the variance pays:
+/// a join through dense fog is weighted as if it were clear.
 fn mis_weight(
     scene: &SceneRefs,
     light: &[BdptVertex],
@@ -454,7 +558,7 @@ pub fn connect(
     let mut camera_vertex = camera[0];
     if s == 1 {
         let pt = &camera[t - 1];
-        if pt.kind != VERTEX_SURFACE || pt.delta {
+        if !pt.scatters() || pt.delta {
             return NOTHING;
         }
         let Some((light_vertex, radiance)) = direct_light(scene, pt, t, id) else {

@@ -11,6 +11,8 @@ use crate::cpu::lights::emission::{
     EMITTER_DELTA_DIRECTION, EMITTER_INFINITE, EMITTER_POINT,
 };
 use crate::cpu::materials::material::bsdf_pdf;
+use crate::cpu::media::medium::MediumStack;
+use crate::cpu::media::phase::hg_phase;
 use crate::cpu::scene_refs::SceneRefs;
 use crate::kernel::types::{Material, PROJECTION_ORTHOGRAPHIC};
 use glam::Vec3;
@@ -21,10 +23,13 @@ pub const VERTEX_CAMERA: u32 = 0;
 pub const VERTEX_LIGHT: u32 = 1;
 /// A surface a subpath met (an emitter among them: a camera subpath may end on one).
 pub const VERTEX_SURFACE: u32 = 2;
+/// A scattering event in a participating medium: its "BSDF" is the medium's phase function
+/// (f = pdf = phase, no cosine anywhere: a point in a volume has no area).
+pub const VERTEX_MEDIUM: u32 = 3;
 
 #[derive(Clone, Copy, Debug)]
 pub struct BdptVertex {
-    /// `VERTEX_CAMERA`, `VERTEX_LIGHT` or `VERTEX_SURFACE`.
+    /// `VERTEX_CAMERA`, `VERTEX_LIGHT`, `VERTEX_SURFACE` or `VERTEX_MEDIUM`.
     pub kind: u32,
     /// For light vertices: `EMITTER_AREA`, `EMITTER_POINT`, `EMITTER_INFINITE` or
     /// `EMITTER_DELTA_DIRECTION` (`src/cpu/lights/emission.rs`).
@@ -50,6 +55,11 @@ pub struct BdptVertex {
     pub pdf_rev: f32,
     /// The vertex scattered by a delta lobe: no connection can end at it.
     pub delta: bool,
+    /// The media the subpath's ray arriving at the vertex was in (media/medium.rs); a
+    /// connection leaving through the surface crosses it first.
+    pub media: MediumStack,
+    /// Medium vertices: the Henyey–Greenstein asymmetry of the medium there.
+    pub g: f32,
 }
 
 impl BdptVertex {
@@ -61,6 +71,11 @@ impl BdptVertex {
     /// Whether the vertex has an area (its density converts with the cosine there).
     pub fn is_on_surface(&self) -> bool {
         self.kind == VERTEX_SURFACE || (self.kind == VERTEX_LIGHT && self.emitter == EMITTER_AREA)
+    }
+
+    /// A surface or medium vertex: one that scatters, where connections can join.
+    pub fn scatters(&self) -> bool {
+        self.kind == VERTEX_SURFACE || self.kind == VERTEX_MEDIUM
     }
 
     /// A point or spot light, or a sun without a disk: nothing can hit it.
@@ -113,6 +128,16 @@ pub fn facing(v: &BdptVertex, w: Vec3) -> (Vec3, Vec3, bool) {
 pub fn surface_pdf(v: &BdptVertex, wo: Vec3, wi: Vec3) -> f32 {
     let (n, coat_n, front_face) = facing(v, wo);
     bsdf_pdf(&v.material, wo, wi, n, coat_n, front_face)
+}
+
+/// The solid-angle density of either subpath's sampling at scattering vertex `v` (a surface's
+/// BSDF, a medium's phase function) producing `wi` for light leaving along `wo`.
+pub fn scatter_pdf(v: &BdptVertex, wo: Vec3, wi: Vec3) -> f32 {
+    if v.kind == VERTEX_MEDIUM {
+        // The phase function's cosine is between the travelled and the scattered direction.
+        return hg_phase(v.g, -wo.dot(wi));
+    }
+    surface_pdf(v, wo, wi)
 }
 
 /// The density with which a light vertex `v` sends its light to `next`: what the light
@@ -178,5 +203,5 @@ pub fn density_to(
     };
     let wo = direction_between(v, prev);
     let wi = direction_between(v, next);
-    to_area_density(surface_pdf(v, wo, wi), v, next)
+    to_area_density(scatter_pdf(v, wo, wi), v, next)
 }
