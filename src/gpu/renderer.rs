@@ -76,6 +76,12 @@ pub const BDPT_MEDIA_ON_GPU: &str = "the GPU kernel's bdpt integrator does not r
      participating media yet; render without --gpu (bdpt then runs on the CPU reference) or \
      use the \"path\" integrator";
 
+/// Why the kernel cannot render `scene` as its parameters say, if it cannot.
+pub fn kernel_refuses(scene: &KernelScene) -> Option<&'static str> {
+    (scene.params.integrator == INTEGRATOR_BDPT && scene.params.medium_count > 0)
+        .then_some(BDPT_MEDIA_ON_GPU)
+}
+
 impl<'a> GpuRenderer<'a> {
     /// A renderer for `scene` with the fastest kernel for it: its objects in uniform buffers
     /// when they fit the device's limit (storage buffers otherwise), and only the features it
@@ -158,8 +164,8 @@ impl<'a> GpuRenderer<'a> {
                 "the kernel variant {variant:?} lacks features the scene uses"
             ));
         }
-        if scene.params.integrator == INTEGRATOR_BDPT && scene.params.medium_count > 0 {
-            return Err(anyhow!("{BDPT_MEDIA_ON_GPU}"));
+        if let Some(why) = kernel_refuses(scene) {
+            return Err(anyhow!("{why}"));
         }
         let device = &ctx.device;
         let params = scene.params;

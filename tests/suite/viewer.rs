@@ -296,6 +296,43 @@ fn i_switches_to_bdpt_and_the_viewer_holds_what_render_writes() {
     );
 }
 
+/// The kernel's bdpt has no medium vertices: I in a fog scene keeps path tracing, says why in
+/// the log (and on stderr and the title), and the window goes on rendering.
+#[test]
+fn i_in_a_medium_keeps_path_tracing_and_says_why() {
+    let Some(session) = Session::start() else {
+        return;
+    };
+    let fog = scene_path("cornell-fog.toml");
+    let log = Session::log_of(&mut session.view(&[
+        fog.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp-per-frame",
+        "1",
+        "--frames",
+        "4",
+        "--script",
+        "1:integrator",
+    ]));
+    let switched = events(&log, "integrator");
+    assert_eq!(switched.len(), 1, "{switched:?}");
+    assert_eq!(switched[0]["integrator"], "path");
+    assert!(
+        switched[0]["error"]
+            .as_str()
+            .is_some_and(|e| e.contains("participating media")),
+        "{switched:?}"
+    );
+    let spp: Vec<u64> = frames(&log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect();
+    assert_eq!(spp, [1, 2, 3, 4], "a refused switch does not restart");
+}
+
 #[test]
 fn a_camera_move_restarts_the_accumulation_and_exposure_does_not() {
     let Some(session) = Session::start() else {

@@ -152,22 +152,27 @@ impl App {
     }
 
     /// A reloaded scene, rendered by the integrator switched to unless the file's own changed;
-    /// where the switched-to one cannot render the new scene (bdpt and a medium), the file's.
+    /// where that one cannot render the new scene (bdpt in a medium, on the GPU), with path
+    /// tracing, and the title says why.
     fn keep_integrator(&mut self, scene: Scene, kernel: KernelScene) -> (Scene, KernelScene) {
         let from_file = scene.render.integrator;
-        if from_file != self.file_integrator {
+        let wanted = if from_file != self.file_integrator {
             self.file_integrator = from_file;
-            self.integrator = from_file;
-            return (scene, kernel);
-        }
-        match App::with_integrator(scene.clone(), kernel.clone(), self.integrator) {
-            Ok(switched) => switched,
-            Err(e) => {
-                self.refuse_integrator(self.integrator, &e);
-                self.integrator = from_file;
-                (scene, kernel)
+            from_file
+        } else {
+            self.integrator
+        };
+        for choice in [wanted, Integrator::Path] {
+            match App::with_integrator(scene.clone(), kernel.clone(), choice) {
+                Ok(chosen) => {
+                    self.integrator = choice;
+                    return chosen;
+                }
+                Err(e) => self.refuse_integrator(choice, &e),
             }
         }
+        self.integrator = from_file;
+        (scene, kernel)
     }
 
     /// Switches between path tracing and bidirectional path tracing (I), restarting the

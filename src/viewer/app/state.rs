@@ -231,14 +231,18 @@ impl App {
         mut kernel: KernelScene,
         integrator: Integrator,
     ) -> Result<(Scene, KernelScene), String> {
-        if scene.render.integrator == integrator {
-            return Ok((scene, kernel));
-        }
-        let scene = scene.with_overrides(&RenderOverrides {
-            integrator: Some(integrator),
-            ..Default::default()
-        })?;
+        let scene = if scene.render.integrator == integrator {
+            scene
+        } else {
+            scene.with_overrides(&RenderOverrides {
+                integrator: Some(integrator),
+                ..Default::default()
+            })?
+        };
         kernel.params.integrator = integrator.kernel_value();
+        if let Some(why) = crate::gpu::renderer::kernel_refuses(&kernel) {
+            return Err(why.into());
+        }
         Ok((scene, kernel))
     }
 
