@@ -13,6 +13,8 @@ compilation. Error: relative MSE = mean over pixels and RGB channels of (x - ref
 (least squares on the relative residuals; b is the reference's own error, which is removed);
 spp needed = a / GOAL; seconds to GOAL = spp needed x seconds per sample. The table is the
 median over the rounds. Every run is kept in OUT/runs.jsonl; the report is Markdown on stdout.
+A reference already in OUT (SCENE-RENDERER-ref-SPP.exr) is reused. Renderers: glint-cpu,
+glint-lavapipe (glint --gpu), cycles, mitsuba, and glint-cpu-sobol (--sampler sobol).
 
     bench/time-to-quality/ttq.py --glint target/release/glint --out /tmp/ttq \
         --scenes scenes/cornell.toml,scenes/bunny.toml,scenes/helmet.toml
@@ -130,6 +132,11 @@ def main():
         name = os.path.splitext(os.path.basename(scene))[0]
         for r in renderers:
             prefix = os.path.join(args.out, f"{name}-{r}-ref")
+            kept = f"{prefix}-{args.ref_spp}.exr"
+            if os.path.exists(kept):  # a reference from an earlier run into the same OUT
+                refs[(name, r)] = read_exr(kept)
+                note(dict(scene=name, renderer=r, reference=True, kept=kept))
+                continue
             try:
                 runs = ladder(args, r, scene, prefix, 1000, [args.ref_spp])
             except (RuntimeError, subprocess.CalledProcessError) as e:
