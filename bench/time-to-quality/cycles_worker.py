@@ -2,7 +2,8 @@
 # prints one JSON line per render: spp, wall seconds and process CPU seconds (user + sys, all
 # threads) of bpy.ops.render.render, and the EXR written. Cycles as a reference: CPU device,
 # a fixed number of threads, no adaptive sampling, no denoiser, no clamping, 8 bounces of
-# every kind, box-like pixel filter, Standard view, linear EXR.
+# every kind, a box pixel filter one pixel wide (glint's jitter over the pixel square),
+# Standard view, linear EXR.
 #
 # Usage: python cycles_worker.py SCENE.toml OUT_PREFIX SIZE SEED THREADS SPP[,SPP...]
 #
@@ -178,7 +179,10 @@ c.transparent_max_bounces = bounces
 c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
 c.caustics_reflective = c.caustics_refractive = True
 c.blur_glossy = 0.0
-c.filter_width = 0.01
+# glint jitters each sample uniformly over its pixel square: a box filter one pixel wide.
+# (A width of 0.01 would put every sample at the pixel centre, without the edge noise.)
+c.pixel_filter_type = "BOX"
+c.filter_width = 1.0
 c.seed = seed
 scene.render.threads_mode = "FIXED"
 scene.render.threads = threads
