@@ -105,13 +105,16 @@ def rotation(axis, degrees):
 
 
 mats = {name: material(name, m) for name, m in toml.get("materials", {}).items()}
+# 128 segments by default; fewer (TTQ_SPHERE_SEGMENTS) for scenes of many small spheres.
+SEGMENTS = int(os.environ.get("TTQ_SPHERE_SEGMENTS", "128"))
 for i, q in enumerate(toml.get("quads", [])):
     c, u, v = Vector(q["corner"]), Vector(q["u"]), Vector(q["v"])
     mesh = bpy.data.meshes.new(f"quad{i}")
     mesh.from_pydata([b(c), b(c + u), b(c + u + v), b(c + v)], [], [(0, 1, 2, 3)])
     link(f"quad{i}", mesh, mats[q["material"]])
 for i, s in enumerate(toml.get("spheres", [])):
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=s["radius"],
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=SEGMENTS, ring_count=SEGMENTS // 2,
+                                         radius=s["radius"],
                                          location=b(s["center"]))
     obj = bpy.context.active_object
     bpy.ops.object.shade_smooth()

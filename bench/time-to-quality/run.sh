@@ -5,7 +5,8 @@
 # Cornell box, the bunny and the helmet under the studio HDRI. See README.md.
 #
 #   GLINT_ASSETS=/path/to/assets bench/time-to-quality/run.sh [OUT]
-#   (ROUNDS=3 SIZE=128 REF_SPP=512 LADDER=4,16,64 THREADS=2 SCENES="cornell bunny helmet")
+#   (ROUNDS=3 SIZE=128 REF_SPP=512 LADDER=4,16,64 THREADS=2 SCENES="cornell bunny helmet";
+#   SCENES=many-lights TTQ_SPHERE_SEGMENTS=32 for the light tree's scene, once main has it)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -27,6 +28,12 @@ for s in ${SCENES:-cornell bunny helmet}; do
             -e "s|\"skies/studio.hdr\"|\"$root/scenes/skies/studio.hdr\"|" \
             "$root/scenes/helmet.toml" > "$out/helmet.toml"
         scenes+=("$out/helmet.toml")
+    elif [ "$s" = many-lights ] && [ ! -e "$root/scenes/many-lights.toml" ]; then
+        # Generated, not kept in the repository (scenes/tools/make_many_lights.py). Its 800
+        # spheres are slow to build in Blender: run it on its own with TTQ_SPHERE_SEGMENTS=32.
+        python3 "$root/scenes/tools/make_many_lights.py" --size "${SIZE:-128}" \
+            --out "$out/many-lights.toml"
+        scenes+=("$out/many-lights.toml")
     else
         scenes+=("$root/scenes/$s.toml")
     fi
