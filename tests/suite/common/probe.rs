@@ -173,6 +173,8 @@ fn run_probe_with(
     let environment_texels = storage_buffer(ctx, "environment map", &scene.environment_texels);
     let environment_alias = storage_buffer(ctx, "environment alias", &scene.environment_alias);
     let lights = storage_buffer(ctx, "lights", &scene.lights);
+    let light_tree_nodes = storage_buffer(ctx, "light tree nodes", &scene.light_tree_nodes);
+    let light_tree_trails = storage_buffer(ctx, "light tree trails", &scene.light_tree_trails);
     let ggx_energy = storage_buffer(ctx, "GGX energy", glint::tables::ggx::ggx_energy_table());
     let dielectric_energy = storage_buffer(
         ctx,
@@ -238,6 +240,8 @@ fn run_probe_with(
         (33, read_only, &dielectric_energy),
         (32, read_only, &sheen_energy),
         (36, read_only, &clearcoat_energy),
+        (48, read_only, &light_tree_nodes),
+        (49, read_only, &light_tree_trails),
     ]
     .into_iter()
     .chain(hardware)
