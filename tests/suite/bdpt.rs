@@ -190,11 +190,13 @@ pub(crate) fn image_mean(image: &Image) -> f64 {
         / (3 * image.pixels.len()) as f64
 }
 
-/// The image mean of `estimate` over `BATCHES` seeds, and its standard error.
-fn mean_and_error(estimate: impl Fn(&KernelScene) -> f64) -> (f64, f64) {
-    let values: Vec<f64> = (0..BATCHES)
-        .map(|b| estimate(&common::bdpt_diffuse_box(8, b + 1)))
-        .collect();
+/// The image mean of `estimate` over `BATCHES` seeds of `scene` (its seeds 1, 2, …), and its
+/// standard error.
+fn mean_and_error(
+    scene: &impl Fn(u32) -> KernelScene,
+    estimate: impl Fn(&KernelScene) -> f64,
+) -> (f64, f64) {
+    let values: Vec<f64> = (0..BATCHES).map(|b| estimate(&scene(b + 1))).collect();
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;
     let variance = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
@@ -209,12 +211,22 @@ fn mean_and_error(estimate: impl Fn(&KernelScene) -> f64) -> (f64, f64) {
 /// the errors from the spread of 16 seeds' image means.
 #[test]
 fn each_strategy_alone_estimates_the_same_light() {
-    let spp = 32;
+    assert_two_scattering_strategies_agree(&|seed| common::bdpt_diffuse_box(8, seed), 32);
+}
+
+/// The check of [`each_strategy_alone_estimates_the_same_light`] on `scene` (by seed) at
+/// `spp`: each strategy with s + t = 4 alone against path tracing's two-scattering light,
+/// within 4 standard errors of the difference, and the weighted ones summing to the render's
+/// to 10⁻⁴.
+pub(crate) fn assert_two_scattering_strategies_agree(
+    scene: &impl Fn(u32) -> KernelScene,
+    spp: u32,
+) {
     let all = Strategies {
         only: None,
         weighted: true,
     };
-    let path_two_scatterings = mean_and_error(|scene| {
+    let path_two_scatterings = mean_and_error(scene, |scene| {
         let mut path = scene.clone();
         path.params.integrator = INTEGRATOR_PATH;
         let two = image_mean(&render(&path, &[spp]).mean_image());
@@ -222,10 +234,9 @@ fn each_strategy_alone_estimates_the_same_light() {
         two - image_mean(&render(&path, &[spp]).mean_image())
     });
     let mut weighted_sum = 0.0;
-    let mut render_two_scatterings = 0.0;
     for s in 0..=3usize {
         let only = Some((s, 4 - s));
-        let alone = mean_and_error(|scene| {
+        let alone = mean_and_error(scene, |scene| {
             image_mean(&strategy_image(
                 scene,
                 spp,
@@ -249,9 +260,8 @@ fn each_strategy_alone_estimates_the_same_light() {
             "strategy ({s}, {}) alone: {alone:?} against path tracing's {path_two_scatterings:?}",
             4 - s
         );
-        let scene = common::bdpt_diffuse_box(8, 1);
         weighted_sum += image_mean(&strategy_image(
-            &scene,
+            &scene(1),
             spp,
             Strategies {
                 only,
@@ -259,10 +269,10 @@ fn each_strategy_alone_estimates_the_same_light() {
             },
         ));
     }
-    let scene = common::bdpt_diffuse_box(8, 1);
-    let mut one_bounce = scene.clone();
+    let first = scene(1);
+    let mut one_bounce = first.clone();
     one_bounce.params.max_bounces = 1;
-    render_two_scatterings += image_mean(&strategy_image(&scene, spp, all))
+    let render_two_scatterings = image_mean(&strategy_image(&first, spp, all))
         - image_mean(&strategy_image(&one_bounce, spp, all));
     eprintln!("weighted sum {weighted_sum:.6}, the render's two-scattering light {render_two_scatterings:.6}");
     assert!(

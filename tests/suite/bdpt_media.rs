@@ -18,9 +18,8 @@
 //! samples: the fog is dense enough (a mean free path of about the box) that a missing
 //! transmittance or phase factor is many standard errors even so.
 
-use crate::bdpt::{batch_means, cpu_renderer, image_mean, render, strategy_image, BATCHES};
+use crate::bdpt::{assert_two_scattering_strategies_agree, batch_means, cpu_renderer, image_mean};
 use crate::common;
-use glint::cpu::integrator::bdpt::Strategies;
 use glint::gpu::GpuRenderer;
 use glint::image::compare::compare;
 use glint::kernel::types::{INTEGRATOR_BDPT, INTEGRATOR_PATH};
@@ -130,18 +129,6 @@ fn bdpt_agrees_with_path_tracing_in_fog_and_in_a_scattering_sphere() {
     assert_agree("scattering sphere", &scattering_sphere(), 16);
 }
 
-/// The image mean of `estimate` over `BATCHES` seeds of the diffuse fog, and its standard
-/// error.
-fn mean_and_error(estimate: impl Fn(&KernelScene) -> f64) -> (f64, f64) {
-    let values: Vec<f64> = (0..BATCHES)
-        .map(|b| estimate(&diffuse_fog(b + 1)))
-        .collect();
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let variance = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0);
-    (mean, (variance / n).sqrt())
-}
-
 /// Paths of exactly two scattering events in the diffuse fog, at surfaces or in the medium:
 /// each of the four strategies that make them (s + t = 4), alone and unweighted, estimates
 /// their light as path tracing's render at two bounces less its render at one does (within
@@ -149,58 +136,7 @@ fn mean_and_error(estimate: impl Fn(&KernelScene) -> f64) -> (f64, f64) {
 /// estimates sum to the render's two-scattering light (the same numbers make both).
 #[test]
 fn each_strategy_alone_estimates_the_same_light_through_fog() {
-    let spp = 16;
-    let path_two = mean_and_error(|scene| {
-        let mut path = scene.clone();
-        path.params.integrator = INTEGRATOR_PATH;
-        let two = image_mean(&render(&path, &[spp]).mean_image());
-        path.params.max_bounces = 1;
-        two - image_mean(&render(&path, &[spp]).mean_image())
-    });
-    let mut weighted_sum = 0.0;
-    for s in 0..=3usize {
-        let only = Some((s, 4 - s));
-        let alone = mean_and_error(|scene| {
-            let unweighted = Strategies {
-                only,
-                weighted: false,
-            };
-            image_mean(&strategy_image(scene, spp, unweighted))
-        });
-        eprintln!(
-            "(s, t) = ({s}, {}): alone {:.5} ± {:.5}, path tracing {:.5} ± {:.5}",
-            4 - s,
-            alone.0,
-            alone.1,
-            path_two.0,
-            path_two.1
-        );
-        let bound = 4.0 * (alone.1.powi(2) + path_two.1.powi(2)).sqrt();
-        assert!(
-            (alone.0 - path_two.0).abs() < bound,
-            "strategy ({s}, {}) alone: {alone:?} against path tracing's {path_two:?}",
-            4 - s
-        );
-        let weighted = Strategies {
-            only,
-            weighted: true,
-        };
-        weighted_sum += image_mean(&strategy_image(&diffuse_fog(1), spp, weighted));
-    }
-    let all = Strategies {
-        only: None,
-        weighted: true,
-    };
-    let scene = diffuse_fog(1);
-    let mut one_bounce = scene.clone();
-    one_bounce.params.max_bounces = 1;
-    let render_two = image_mean(&strategy_image(&scene, spp, all))
-        - image_mean(&strategy_image(&one_bounce, spp, all));
-    eprintln!("weighted sum {weighted_sum:.6}, the render's two-scattering light {render_two:.6}");
-    assert!(
-        (weighted_sum / render_two - 1.0).abs() < 1e-4,
-        "weighted strategies sum to {weighted_sum}, the render has {render_two}"
-    );
+    assert_two_scattering_strategies_agree(&diffuse_fog, 16);
 }
 
 /// Density grids with bdpt are refused by name: in grid_media.rs's smooth blob under a sun
