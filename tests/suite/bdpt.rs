@@ -80,17 +80,30 @@ fn assert_agree(name: &str, scene: &KernelScene, spp: u32, renderer: MakeRendere
     // hit the light: its per-batch means are skewed (mostly low, now and then far too high),
     // and at bidirectional's spp their spread understates its error. Four times the samples
     // tame that.
-    let path = batch_means(scene, INTEGRATOR_PATH, 4 * spp, renderer);
+    assert_agree_with_path_spp(name, scene, spp, 4 * spp, renderer);
+}
+
+/// [`assert_agree`] with path tracing at `path_spp`.
+pub(crate) fn assert_agree_with_path_spp(
+    name: &str,
+    scene: &KernelScene,
+    spp: u32,
+    path_spp: u32,
+    renderer: MakeRenderer,
+) {
+    let path = batch_means(scene, INTEGRATOR_PATH, path_spp, renderer);
     let bdpt = batch_means(scene, INTEGRATOR_BDPT, spp, renderer);
     let z = compare(&path.0, &bdpt.0, Some((&path.1, &bdpt.1)))
         .unwrap()
         .z_test
         .unwrap();
     eprintln!(
-        "{name}: pass rate {:.2}% of {}, z of means {:.2}",
+        "{name}: pass rate {:.2}% of {}, z of means {:.2}, means {:.5} (path) {:.5} (bdpt)",
         100.0 * z.pass_rate,
         z.tested,
-        z.z_of_means
+        z.z_of_means,
+        image_mean(&path.0),
+        image_mean(&bdpt.0)
     );
     assert!(
         z.pass_rate >= MIN_PASS_RATE,

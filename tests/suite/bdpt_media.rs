@@ -18,15 +18,13 @@
 //! samples: the fog is dense enough (a mean free path of about the box) that a missing
 //! transmittance or phase factor is many standard errors even so.
 
-use crate::bdpt::{assert_two_scattering_strategies_agree, batch_means, cpu_renderer, image_mean};
+use crate::bdpt::{
+    assert_agree_with_path_spp, assert_two_scattering_strategies_agree, cpu_renderer,
+};
 use crate::common;
 use glint::gpu::GpuRenderer;
-use glint::image::compare::compare;
-use glint::kernel::types::{INTEGRATOR_BDPT, INTEGRATOR_PATH};
+use glint::kernel::types::INTEGRATOR_BDPT;
 use glint::kernel::KernelScene;
-
-const MIN_PASS_RATE: f64 = 0.95;
-const MAX_Z_OF_MEANS: f64 = 4.0;
 
 /// Chromatic fog (σs = (1.5, 2, 3)·10⁻³, a mean free path about the box's size, forwards
 /// g = 0.3) in scenes/cornell-fog.toml's box, at 8² pixels and `max_bounces` bounces.
@@ -92,30 +90,7 @@ fn assert_agree(name: &str, scene: &KernelScene, spp: u32) {
     // next-event estimation's vertices) come from rare large samples, which skew its batch
     // means low with too small a spread (at 4×, 8% of the fog's pixel channels failed, all
     // of them path tracing darker; at 16× and 64×, 2 to 4%). bdpt.rs takes 4×.
-    let path = batch_means(scene, INTEGRATOR_PATH, 16 * spp, &cpu_renderer);
-    let bdpt = batch_means(scene, INTEGRATOR_BDPT, spp, &cpu_renderer);
-    let z = compare(&path.0, &bdpt.0, Some((&path.1, &bdpt.1)))
-        .unwrap()
-        .z_test
-        .unwrap();
-    eprintln!(
-        "{name}: pass rate {:.2}% of {}, z of means {:.2}, means {:.5} (path) {:.5} (bdpt)",
-        100.0 * z.pass_rate,
-        z.tested,
-        z.z_of_means,
-        image_mean(&path.0),
-        image_mean(&bdpt.0)
-    );
-    assert!(
-        z.pass_rate >= MIN_PASS_RATE,
-        "{name}: pass rate {}",
-        z.pass_rate
-    );
-    assert!(
-        z.z_of_means.abs() < MAX_Z_OF_MEANS,
-        "{name}: z of means {}",
-        z.z_of_means
-    );
+    assert_agree_with_path_spp(name, scene, spp, 16 * spp, &cpu_renderer);
 }
 
 #[test]
