@@ -13,12 +13,21 @@ struct PathState {
     ray_start: vec3<f32>,
     // How the current ray was sampled, for weighting the emitter it may hit.
     bsdf_pdf_of_ray: f32,
+    // Segments traced so far: each has its own random streams and alpha key.
     bounce: u32,
+    // Interfaces crossed so far (cross_interface): segments without a scattering event.
+    crossings: u32,
     came_from_delta: bool,
     // Albedo, normal and depth for the denoiser (aov.wgsl); untouched unless AOVS.
     aov: PathAov,
     // The participating media the ray is in (media/medium.wgsl); empty without media.
     media: MediumStack,
+}
+
+// Scattering events so far, at surfaces and in media: what max_bounces, Russian roulette and
+// the firefly clamp count (interfaces crossed are not among them).
+fn scatterings(path: PathState) -> u32 {
+    return path.bounce - path.crossings;
 }
 
 // Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
@@ -36,7 +45,7 @@ fn start_path(pixel: u32, px: u32, py: u32, sample: u32) -> PathState {
     let jitter = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let lens = vec2<f32>(rng_next(&camera_rng), rng_next(&camera_rng));
     let ray = camera_ray(px, py, jitter, lens);
-    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, true, aov_start(), medium_start());
+    return PathState(ray, vec3<f32>(1.0), vec3<f32>(0.0), ray.origin, 0.0, 0u, 0u, true, aov_start(), medium_start());
 }
 
 // Traces one segment of the path (and its shadow ray); true when the path has ended.
@@ -74,12 +83,14 @@ fn path_step(path: ptr<function, PathState>, pixel: u32, sample: u32) -> bool {
         (*path).throughput *= volume_transmittance(m, hit.t);
     }
     add_hit_emission(path, m, hit, light_sampling);
-    // max_bounces counts scattering events; this also bounds every path's length.
-    if bounce >= params.max_bounces {
-        return true;
-    }
+    // Before the bounce limit: a path that has scattered max_bounces times still leaves
+    // through the interfaces around it, to the light beyond.
     if HAS_MEDIA && is_interface(m) {
         return cross_interface(path, hit);
+    }
+    // max_bounces counts scattering events (scatterings()).
+    if scatterings(*path) >= params.max_bounces {
+        return true;
     }
     let origin = offset_ray_origin(hit.position, hit.error, hit.normal);
     if light_sampling && !is_delta(m) {
@@ -120,7 +131,7 @@ fn add_escaped_light(path: ptr<function, PathState>, light_sampling: bool) {
         let mis = light_sampling && !(*path).came_from_delta;
         escaped += sun_disks_radiance(ray.dir, (*path).bsdf_pdf_of_ray, mis);
     }
-    (*path).radiance += firefly_clamp((*path).throughput * escaped, (*path).bounce);
+    (*path).radiance += firefly_clamp((*path).throughput * escaped, scatterings(*path));
 }
 
 // The material's normal maps at a triangle hit: the base's replaces the hit's shading normal;
@@ -152,7 +163,7 @@ fn apply_normal_maps(m: Material, hit: ptr<function, Hit>, wo: vec3<f32>) -> vec
 fn add_hit_emission(path: ptr<function, PathState>, m: Material, hit: Hit, light_sampling: bool) {
     if any(m.emission > vec3<f32>(0.0)) {
         let weight = bsdf_ray_mis_weight(path, hit.primitive, hit.index, light_sampling);
-        (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, (*path).bounce);
+        (*path).radiance += firefly_clamp((*path).throughput * m.emission * weight, scatterings(*path));
     }
 }
 
@@ -222,7 +233,7 @@ fn add_unblocked_light(
     let pdf = bsdf_pdf(m, wo, light.dir, hit.shading_normal, coat_normal, hit.front_face);
     let weight = nee_weight(light, pdf);
     let contribution = (*path).throughput * f_cos * light.radiance * (weight / light.pdf) * through;
-    (*path).radiance += firefly_clamp(contribution, bounce + 1u);
+    (*path).radiance += firefly_clamp(contribution, scatterings(*path) + 1u);
 }
 
 // Samples the BSDF for the path's next ray, with Russian roulette from params.roulette_start;
@@ -250,7 +261,7 @@ fn scatter(
     if HAS_MEDIA && dot(s.dir, hit.normal) < 0.0 {
         (*path).media = medium_crossed((*path).media, hit.material, hit.front_face);
     }
-    if bounce >= params.roulette_start {
+    if scatterings(*path) >= params.roulette_start {
         // Russian roulette: continue with probability q and divide by it, so the estimate
         // stays unbiased while dim paths end early.
         var roulette_rng = rng_stream(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed, params.sampler);

@@ -26,7 +26,7 @@ fn free_flight(path: ptr<function, PathState>, t_hit: f32, pixel: u32, sample: u
 // path ends here.
 fn medium_vertex(path: ptr<function, PathState>, position: vec3<f32>, light_sampling: bool, pixel: u32, sample: u32) -> bool {
     let bounce = (*path).bounce;
-    if bounce >= params.max_bounces {
+    if scatterings(*path) >= params.max_bounces {
         return true;
     }
     let g = params.media[current_medium((*path).media)].g;
@@ -44,7 +44,7 @@ fn medium_vertex(path: ptr<function, PathState>, position: vec3<f32>, light_samp
             if any(through > vec3<f32>(0.0)) {
                 let weight = nee_weight(light, phase);
                 let contribution = (*path).throughput * through * light.radiance * (phase * weight / light.pdf);
-                (*path).radiance += firefly_clamp(contribution, bounce + 1u);
+                (*path).radiance += firefly_clamp(contribution, scatterings(*path) + 1u);
             }
         }
     }
@@ -54,7 +54,7 @@ fn medium_vertex(path: ptr<function, PathState>, position: vec3<f32>, light_samp
     let dir = sample_hg(g, d, u1, u2);
     let pdf = hg_phase(g, dot(d, dir));
     var throughput = (*path).throughput;
-    if bounce >= params.roulette_start {
+    if scatterings(*path) >= params.roulette_start {
         var roulette_rng = rng_stream(pixel, sample, stream_id(bounce, PURPOSE_ROULETTE), params.seed, params.sampler);
         let q = min(max(throughput.x, max(throughput.y, throughput.z)), 0.95);
         if rng_next(&roulette_rng) >= q {
@@ -72,13 +72,15 @@ fn medium_vertex(path: ptr<function, PathState>, position: vec3<f32>, light_samp
 }
 
 // Straight through an interface: no scattering event, so the previous vertex's pdf, origin
-// and delta flag stay for MIS; the segment counts against max_bounces.
+// and delta flag stay for MIS; not counted against max_bounces, but the path ends at
+// segment_limit segments.
 fn cross_interface(path: ptr<function, PathState>, hit: Hit) -> bool {
-    if (*path).bounce >= params.max_bounces {
+    if (*path).bounce + 1u >= segment_limit(params.max_bounces + 2u) {
         return true;
     }
     (*path).media = medium_crossed((*path).media, hit.material, hit.front_face);
     (*path).ray = Ray(offset_ray_origin(hit.position, hit.error, -hit.normal), (*path).ray.dir);
     (*path).bounce += 1u;
+    (*path).crossings += 1u;
     return false;
 }

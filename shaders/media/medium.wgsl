@@ -4,6 +4,12 @@
 const MEDIUM_STACK_SIZE: u32 = 4u;
 const MAX_SHADOW_CROSSINGS: u32 = 8u;
 
+// Segments a path or subpath of at most max_vertices vertices traces at most: its scattering
+// events' and the interfaces crossed between them, which max_bounces does not count.
+fn segment_limit(max_vertices: u32) -> u32 {
+    return 4u * max_vertices + 8u;
+}
+
 // The media a path is in: slots[0 .. depth], innermost last.
 struct MediumStack {
     slots: array<u32, 4>,

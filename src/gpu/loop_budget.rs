@@ -69,7 +69,7 @@ fn grid_iterations(scene: &KernelScene) -> u64 {
     if scene.grids.is_empty() || scene.params.medium_count == 0 {
         return 0;
     }
-    let segments = scene.params.max_bounces as u64 + 1;
+    let segments = path_segments(&scene.params);
     let crossings = crate::cpu::media::medium::MAX_SHADOW_CROSSINGS as u64;
     let per_track = crate::cpu::media::grid::MAX_TRACKING_STEPS as u64 + 6;
     segments * (1 + crossings) * per_track
@@ -111,8 +111,18 @@ pub fn bdpt_loop_iterations_per_sample(params: &Params, per_ray: u64) -> u64 {
     walks + (b + 2) + joins * per_join + 1 + 2
 }
 
+/// The most segments a path traces: one per scattering event and the camera's without media;
+/// with media, also the interfaces it crosses, which `max_bounces` does not count, up to the
+/// path tracer's `segment_limit` (src/cpu/media/medium.rs).
+fn path_segments(params: &Params) -> u64 {
+    if params.medium_count > 0 {
+        return crate::cpu::media::medium::segment_limit(params.max_bounces + 2) as u64;
+    }
+    params.max_bounces as u64 + 1
+}
+
 fn sample_iterations(params: &Params, per_ray: u64) -> u64 {
-    let segments = params.max_bounces as u64 + 1;
+    let segments = path_segments(params);
     if params.medium_count > 0 {
         // Media (shaders/media/medium.wgsl): a shadow ray casts one ray per interface it
         // crosses, and each crossing looks its medium up among the slots and the stack.

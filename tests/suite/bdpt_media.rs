@@ -6,6 +6,7 @@
 //! - in an all-diffuse fogged box, each strategy (s, t) alone, unweighted, estimates the light
 //!   of the paths of its length (medium vertices among them), and the weighted ones sum to the
 //!   render's: the MIS weights sum to 1 over the strategies that can make each path;
+//! - in a density grid under a sun and a sky, the two integrators agree;
 //! - the GPU kernel, whose bidirectional integrator has no medium vertices yet, refuses such a
 //!   scene by name instead of rendering it wrong.
 //!
@@ -114,28 +115,26 @@ fn each_strategy_alone_estimates_the_same_light_through_fog() {
     assert_two_scattering_strategies_agree(&diffuse_fog, 16);
 }
 
-/// Density grids with bdpt are refused by name: in grid_media.rs's smooth blob under a sun
-/// and a sky, bdpt came out 12% brighter than path tracing (cause not found yet).
+/// In grid_media.rs's smooth blob (chromatic, denser than its own tests) under a sun and a
+/// grey sky, at max_bounces 4, bdpt agrees with path tracing, as in the homogeneous fog above
+/// (its variance from 16 batches, path tracing at 4× the samples). bdpt was once refused with
+/// grids because it came out 12% brighter here: the path tracer counted crossing the volume's
+/// box against max_bounces and stopped at the bounce limit before leaving through it, so at
+/// few bounces it missed light bdpt found (z of means −37.6, 50% of pixel channels passing;
+/// with crossings not counted but the limit still checked before the crossing, −10.5).
 #[test]
-fn bdpt_refuses_density_grids_by_name() {
+fn bdpt_agrees_with_path_tracing_in_a_density_grid() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("grid.vdb"),
-        common::vdb::write_vdb(&[crate::grid_media::smooth_grid()]),
-    )
-    .unwrap();
-    let toml = "[camera]\neye = [0.0, 0.0, -4.0]\ntarget = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nvfov = 40\n\
-        [render]\nwidth = 4\nheight = 4\nspp = 1\nmax_bounces = 4\nintegrator = \"bdpt\"\n[media.smoke]\ngrid = \"grid.vdb\"\ncolor = [0.9, 0.8, 0.6]\ndensity = 8.0\n\
-        [[volumes]]\nmedium = \"smoke\"\nscale = 0.1\n\
-        [[lights]]\ntype = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nintensity = 3.0\n";
-    let Err(err) = glint::scene::Scene::parse(toml, &dir.path().join("scene.toml")) else {
-        panic!("a density grid with bdpt was accepted");
-    };
-    let err = err.to_string();
-    assert!(
-        err.contains("does not render density-grid media yet"),
-        "{err}"
+    let scene = crate::grid_media::grid_scene(
+        dir.path(),
+        &crate::grid_media::smooth_grid(),
+        "color = [0.9, 0.8, 0.6]\ndensity = 8.0",
+        0.1,
+        8,
+        1,
+        0,
     );
+    assert_agree_with_path_spp("density grid", &scene, 16, 64, &cpu_renderer);
 }
 
 /// The kernel's bidirectional integrator has no medium vertices: a scene with media is

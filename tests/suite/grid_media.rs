@@ -88,7 +88,7 @@ pub(crate) fn smooth_grid() -> VdbGrid {
 
 /// The kernel scene, `size` pixels square, of a volume of `grid` (written to `dir`) with
 /// `medium`'s coefficients, scaled by `scale`.
-fn grid_scene(
+pub(crate) fn grid_scene(
     dir: &Path,
     grid: &VdbGrid,
     medium: &str,

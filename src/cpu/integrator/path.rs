@@ -37,12 +37,24 @@ pub struct PathState {
     pub ray_start: Vec3,
     /// How the current ray was sampled, for weighting the emitter it may hit.
     pub bsdf_pdf_of_ray: f32,
+    /// Segments traced so far: each has its own random streams and alpha key.
     pub bounce: u32,
+    /// Interfaces crossed so far (`cross_interface`): segments without a scattering event.
+    pub crossings: u32,
     pub came_from_delta: bool,
     /// Albedo, normal and depth for the denoiser (aov.rs); untouched unless `params.aovs`.
     pub aov: PathAov,
     /// The participating media the ray is in (media/medium.rs); empty without media.
     pub media: MediumStack,
+}
+
+impl PathState {
+    /// Scattering events so far, at surfaces and in media: what `max_bounces`, Russian
+    /// roulette and the firefly clamp count. Interfaces crossed are not among them, as in
+    /// pbrt-v4's and Mitsuba 3's volumetric path tracers and in bdpt's subpaths.
+    pub fn scatterings(&self) -> u32 {
+        self.bounce - self.crossings
+    }
 }
 
 /// Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
@@ -67,6 +79,7 @@ pub fn start_path(params: &Params, pixel: u32, px: u32, py: u32, sample: u32) ->
         ray_start: ray.origin,
         bsdf_pdf_of_ray: 0.0,
         bounce: 0,
+        crossings: 0,
         came_from_delta: true,
         aov: aov_start(),
         media: medium_start(params),
@@ -146,12 +159,14 @@ pub fn path_step<const MEDIA: bool>(
         path.throughput *= volume_transmittance(m, hit.t);
     }
     add_hit_emission(scene, path, m, &hit, light_sampling);
-    // max_bounces counts scattering events; this also bounds every path's length.
-    if bounce >= params.max_bounces {
-        return true;
-    }
+    // Before the bounce limit: a path that has scattered max_bounces times still leaves
+    // through the interfaces around it, to the light beyond.
     if MEDIA && is_interface(m) {
         return cross_interface(scene, path, &hit);
+    }
+    // max_bounces counts scattering events (`PathState::scatterings`).
+    if path.scatterings() >= params.max_bounces {
+        return true;
     }
     let vertex = Vertex {
         material: m,
@@ -215,7 +230,7 @@ fn add_escaped_light(scene: &SceneRefs, path: &mut PathState, light_sampling: bo
         let mis = light_sampling && !path.came_from_delta;
         escaped += sun_disks_radiance(scene, ray.dir, path.bsdf_pdf_of_ray, mis);
     }
-    path.radiance += firefly_clamp(params, path.throughput * escaped, path.bounce);
+    path.radiance += firefly_clamp(params, path.throughput * escaped, path.scatterings());
 }
 
 /// The material's normal maps at a triangle hit: the base's replaces `hit`'s shading normal;
@@ -269,7 +284,7 @@ fn add_hit_emission(
         path.radiance += firefly_clamp(
             scene.params,
             path.throughput * emission * weight,
-            path.bounce,
+            path.scatterings(),
         );
     }
 }
@@ -372,7 +387,7 @@ fn add_unblocked_light<const MEDIA: bool>(
     );
     let weight = nee_weight(light, pdf);
     let contribution = path.throughput * f_cos * light.radiance * (weight / light.pdf) * through;
-    path.radiance += firefly_clamp(params, contribution, bounce + 1);
+    path.radiance += firefly_clamp(params, contribution, path.scatterings() + 1);
 }
 
 /// Samples the BSDF for the path's next ray, with Russian roulette from
@@ -412,7 +427,7 @@ fn scatter<const MEDIA: bool>(
     if MEDIA && s.dir.dot(hit.normal) < 0.0 {
         path.media = medium_crossed(params, &path.media, hit.material, hit.front_face);
     }
-    if bounce >= params.roulette_start {
+    if path.scatterings() >= params.roulette_start {
         // Russian roulette: continue with probability q and divide by it, so the estimate
         // stays unbiased while dim paths end early.
         let mut roulette_rng = Rng::with_sampler(

@@ -14,7 +14,8 @@ use crate::cpu::integrator::path::{firefly_clamp, PathState};
 use crate::cpu::lights::light_sample::nee_weight;
 use crate::cpu::lights::sampling::sample_light;
 use crate::cpu::media::medium::{
-    current_medium, medium_crossed, sample_flight, shadow_transmittance, FreeFlight, TrackingStream,
+    current_medium, medium_crossed, sample_flight, segment_limit, shadow_transmittance, FreeFlight,
+    TrackingStream,
 };
 use crate::cpu::media::phase::{hg_phase, sample_hg};
 use crate::cpu::scene_refs::SceneRefs;
@@ -61,7 +62,7 @@ pub fn medium_vertex(
     let params = scene.params;
     let bounce = path.bounce;
     // A scattering event like a surface's: max_bounces counts it.
-    if bounce >= params.max_bounces {
+    if path.scatterings() >= params.max_bounces {
         return true;
     }
     let g = params.media[current_medium(params, &path.media) as usize].g;
@@ -102,7 +103,7 @@ pub fn medium_vertex(
                 let weight = nee_weight(&light, phase);
                 let contribution =
                     path.throughput * through * light.radiance * (phase * weight / light.pdf);
-                path.radiance += firefly_clamp(params, contribution, bounce + 1);
+                path.radiance += firefly_clamp(params, contribution, path.scatterings() + 1);
             }
         }
     }
@@ -113,7 +114,7 @@ pub fn medium_vertex(
     let pdf = hg_phase(g, d.dot(dir));
     // Phase sampling is exact: the phase function over its pdf is 1.
     let mut throughput = path.throughput;
-    if bounce >= params.roulette_start {
+    if path.scatterings() >= params.roulette_start {
         // The same decision as at a surface (path.rs): continue with probability q.
         let stream = stream_id(bounce, PURPOSE_ROULETTE);
         let mut roulette_rng =
@@ -139,11 +140,12 @@ pub fn medium_vertex(
 /// The path goes straight through an interface (media/medium.rs's `is_interface`) into the
 /// medium beyond. Not a scattering event: the previous vertex's pdf, origin and delta flag
 /// stay, so that a light hit beyond is weighted against next-event estimation from that
-/// vertex, whose shadow rays cross interfaces too. The segment still counts against
-/// max_bounces (each segment has its own random streams); true when the path ends here.
+/// vertex, whose shadow rays cross interfaces too. The segment has random streams of its own
+/// but is not counted against max_bounces; the path ends at `segment_limit` segments, as a
+/// bdpt camera subpath does. True when the path ends here.
 pub fn cross_interface(scene: &SceneRefs, path: &mut PathState, hit: &Hit) -> bool {
     let params = scene.params;
-    if path.bounce >= params.max_bounces {
+    if path.bounce + 1 >= segment_limit(params.max_bounces + 2) {
         return true;
     }
     path.media = medium_crossed(params, &path.media, hit.material, hit.front_face);
@@ -152,5 +154,6 @@ pub fn cross_interface(scene: &SceneRefs, path: &mut PathState, hit: &Hit) -> bo
         dir: path.ray.dir,
     };
     path.bounce += 1;
+    path.crossings += 1;
     false
 }

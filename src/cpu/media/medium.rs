@@ -37,6 +37,13 @@ pub const MEDIUM_STACK_SIZE: usize = 4;
 /// `src/gpu/loop_budget.rs`).
 pub const MAX_SHADOW_CROSSINGS: u32 = 8;
 
+/// Segments a path or subpath of at most `max_vertices` vertices (the camera's included) traces
+/// at most: its scattering events' and, between them, interfaces crossed, which `max_bounces`
+/// does not count. Bounds a path caught between interfaces.
+pub fn segment_limit(max_vertices: u32) -> u32 {
+    4 * max_vertices + 8
+}
+
 /// The media a path is in: `slots[..depth]`, innermost last.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MediumStack {

@@ -93,16 +93,6 @@ impl SceneToml {
                 ),
             ));
         }
-        if settings.integrator == Integrator::Bdpt && media.list.iter().any(|m| m.grid.is_some()) {
-            // Measured 12% brighter than path tracing in a grid under a sun
-            // (tests/suite/bdpt_media.rs): refused until that is understood.
-            return Err(whole(
-                "render.integrator",
-                "the bdpt integrator does not render density-grid media yet; use \"path\" \
-                 (homogeneous media render with bdpt on the CPU)"
-                    .into(),
-            ));
-        }
         let mut warnings = objects.warnings;
         warnings.extend(media::downsampling_warnings(&media));
         let environment = match &self.environment {

@@ -31,8 +31,8 @@ use crate::cpu::lights::emission::{
 };
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample};
 use crate::cpu::media::medium::{
-    current_medium, is_interface, medium_crossed, medium_start, sample_flight, transmittance,
-    MediumStack,
+    current_medium, is_interface, medium_crossed, medium_start, sample_flight, segment_limit,
+    transmittance, MediumStack,
 };
 use crate::cpu::media::phase::{hg_phase, sample_hg};
 use crate::cpu::scene_refs::SceneRefs;
@@ -122,11 +122,6 @@ struct Walk {
     segment: u32,
 }
 
-/// Segments a walk traces at most: every vertex's, and interfaces between them.
-fn segment_limit(max_vertices: usize) -> u32 {
-    4 * max_vertices as u32 + 8
-}
-
 /// Follows the walk from `path[count - 1]`, adding vertices until `max_vertices`, an escape or
 /// an absorption; returns the number of vertices. `from_light`: a light subpath (importance).
 /// In a scene with media, each segment first samples a free flight through the medium it is
@@ -146,7 +141,7 @@ fn random_walk(
     let params = scene.params;
     let media_on = params.medium_count > 0;
     let first_bounce = if from_light { LIGHT_SUBPATH } else { 0 };
-    while count < max_vertices && walk.segment < segment_limit(max_vertices) {
+    while count < max_vertices && walk.segment < segment_limit(max_vertices as u32) {
         // Segment b leaves vertex count - 1 (the camera or the light: b = 0) where no
         // interface was crossed.
         let bounce = walk.segment;
