@@ -538,6 +538,14 @@ fn bad_grids_are_refused_with_named_errors() {
         parsed.density[1]
     );
 
+    // A type named as half floats without the metadata that says so (which the reader goes
+    // by) is refused, not read as 32-bit floats.
+    let mut unmarked = VdbGrid::float("density", [2, 2, 2], |_, _, _| 1.0);
+    unmarked.grid_type = "Tree_float_5_4_3_HalfFloat".into();
+    let e = glint::scene::grid::parse_density_grid(&write_vdb(&[unmarked]), "density", "unmarked")
+        .unwrap_err();
+    assert!(e.contains("is_saved_as_half_float"), "{e}");
+
     // Every truncation of a valid file is an error, none a panic (one in 7 lengths, and the
     // last 64: the file is some 6 KB).
     let whole = write_vdb(&[smooth_grid()]);
