@@ -5,10 +5,10 @@ OpenVDB 11 writes them. Python's standard library only:
 
     python3 scenes/tools/make_smoke.py [--size 48] [--out scenes/smoke.vdb] [--blosc] [--active-mask]
 
-The file (a few hundred KB) is not kept in the repository; this script is. Blender's smoke
-(mantaflow) bakes would be the natural source, but the `bpy` module's headless bake fails in
-Blender 4.2 and later ("'LevelsetGrid' object has no attribute 'setConst'", a known problem
-of the module build), so the plume is made here. The writer follows the format as
+The file (a few hundred KB) is not kept in the repository; this script is. A real Blender
+smoke bake is scenes/tools/bake_blender_smoke.py's (it needs Blender's executable: the `bpy`
+module's headless bake fails, "'LevelsetGrid' object has no attribute 'setConst'"); this
+plume is larger and needs nothing but Python. The writer follows the format as
 tests/suite/common/vdb.rs does (see there for the layout).
 """
 
@@ -112,7 +112,8 @@ def write_vdb(voxels, voxel_size, translation):
         tree.setdefault(i5, {}).setdefault(i4, {})[i3] = v
     head = struct.pack("<qIIIB", 0x56444220, 224, 11, 0, 1)
     head += b"5f0d3a52-7c1e-4b8e-9a51-2d7e4c3b9f10" + struct.pack("<I", 0) + struct.pack("<I", 1)
-    head += string("density") + string("Tree_float_5_4_3") + string("")
+    # Saved as half floats: OpenVDB appends "_HalfFloat" to the type and sets the metadata.
+    head += string("density") + string("Tree_float_5_4_3_HalfFloat") + string("")
     grid_pos = len(head) + 24
     # Blosc or zip, with or without active-mask compression.
     grid = struct.pack("<I", (4 if BLOSC else 1) | (2 if ACTIVE_MASK else 0))

@@ -175,8 +175,14 @@ fn quietly<T>(f: impl FnOnce() -> T + std::panic::UnwindSafe) -> std::thread::Re
     result
 }
 
-/// The grid types glint reads: 32-bit float grids (also those saved as half floats).
+/// The grid types glint reads: 32-bit float grids, also those saved as half floats (the
+/// grid's `is_saved_as_half_float` metadata, which is what the reader goes by; OpenVDB's
+/// `io::File` then also appends [`HALF_FLOAT_SUFFIX`] to the type name, as in Blender's
+/// fluid caches).
 const FLOAT_GRID: &str = "Tree_float_5_4_3";
+
+/// What OpenVDB appends to a grid's type name when it saves the grid as half floats.
+const HALF_FLOAT_SUFFIX: &str = "_HalfFloat";
 
 /// The smallest factor f (at most [`MAX_DOWNSAMPLE`]) such that the grid of `size` voxels
 /// averaged over f³ blocks fits one binding: 1 when it fits as it is.
@@ -246,11 +252,21 @@ fn read_with_vdb_rs(bytes: &[u8], grid_name: &str, shown: &str) -> Result<Densit
             }
         ));
     };
-    if descriptor.grid_type != FLOAT_GRID {
+    let grid_type = descriptor.grid_type.as_str();
+    if grid_type != FLOAT_GRID && grid_type.strip_suffix(HALF_FLOAT_SUFFIX) != Some(FLOAT_GRID) {
         return Err(format!(
             "grid {grid_name:?} of {shown} is of type {}, which glint cannot read as a density: \
-             it reads float grids ({FLOAT_GRID}, also saved as half floats)",
+             it reads float grids ({FLOAT_GRID}, also saved as half floats: \
+             {FLOAT_GRID}{HALF_FLOAT_SUFFIX})",
             descriptor.grid_type
+        ));
+    }
+    // The reader goes by the metadata, OpenVDB by the type name; OpenVDB writes both.
+    if grid_type != FLOAT_GRID && !descriptor.meta_data.is_half_float() {
+        return Err(format!(
+            "grid {grid_name:?} of {shown} is of type {grid_type} but lacks the \
+             is_saved_as_half_float metadata OpenVDB writes with it, which glint's reader needs \
+             to read its half floats"
         ));
     }
     if !descriptor.instance_parent.is_empty() {

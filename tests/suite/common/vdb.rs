@@ -17,7 +17,8 @@ pub struct VdbGrid {
     pub name: String,
     /// `Tree_float_5_4_3` for a float grid.
     pub grid_type: String,
-    /// Values stored as 16-bit floats (`is_saved_as_half_float`), as Blender's caches may be.
+    /// Values stored as 16-bit floats (`is_saved_as_half_float`, and the type named with
+    /// `_HalfFloat` after it), as OpenVDB saves them and Blender's caches are.
     pub half: bool,
     pub voxel_size: f64,
     pub translation: [f64; 3],
@@ -105,7 +106,12 @@ pub fn write_vdb(grids: &[VdbGrid]) -> Vec<u8> {
     out.extend((grids.len() as u32).to_le_bytes());
     for g in grids {
         string(&mut out, &g.name);
-        string(&mut out, &g.grid_type);
+        // OpenVDB names a grid saved as half floats by its type and "_HalfFloat".
+        if g.half {
+            string(&mut out, &format!("{}_HalfFloat", g.grid_type));
+        } else {
+            string(&mut out, &g.grid_type);
+        }
         string(&mut out, "");
         let positions = out.len();
         out.extend([0u8; 24]);
