@@ -26,8 +26,12 @@ struct PathState {
 
 // Scattering events so far, at surfaces and in media: what max_bounces, Russian roulette and
 // the firefly clamp count (interfaces crossed are not among them).
+// Without media no interface is crossed: the constant keeps the subtraction out.
 fn scatterings(path: PathState) -> u32 {
-    return path.bounce - path.crossings;
+    if HAS_MEDIA {
+        return path.bounce - path.crossings;
+    }
+    return path.bounce;
 }
 
 // Firefly clamp (`--clamp`, biased): light that has scattered at least once contributes at
