@@ -23,6 +23,7 @@ use crate::bdpt::{
     assert_agree_with_path_spp, assert_two_scattering_strategies_agree, cpu_renderer,
 };
 use crate::common;
+use glint::cpu::media::medium::media_around;
 use glint::gpu::GpuRenderer;
 use glint::kernel::types::INTEGRATOR_BDPT;
 use glint::kernel::KernelScene;
@@ -135,6 +136,117 @@ fn bdpt_agrees_with_path_tracing_in_a_density_grid() {
         0,
     );
     assert_agree_with_path_spp("density grid", &scene, 16, 64, &cpu_renderer);
+}
+
+/// A lamp inside a sphere of fog (behind an interface), and an emitting quad inside another,
+/// seen from outside in the dark: bdpt agrees with path tracing. Light subpaths start in the
+/// media around their emitter (`media_around`, a walk out of the scene from the light's
+/// point); when they started in the global medium (clear here), their first flights crossed
+/// the fog without scattering: bdpt's mean was 0.0092 against path tracing's 0.0698 (z of
+/// means 46.6, 53.7% of pixel channels passing).
+#[test]
+fn bdpt_agrees_with_path_tracing_with_lamps_inside_fog() {
+    let text = r#"
+[camera]
+eye = [0.0, 0.0, -6.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40
+[render]
+width = 8
+height = 8
+spp = 1
+max_bounces = 4
+[materials.boundary]
+type = "interface"
+[materials.lamp]
+type = "diffuse"
+color = [0.0, 0.0, 0.0]
+emission = [4.0, 4.0, 4.0]
+[media.fog]
+sigma_a = [0.05, 0.1, 0.2]
+sigma_s = [0.8, 0.6, 0.4]
+g = 0.3
+[[spheres]]
+center = [-1.1, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+medium = "fog"
+[[spheres]]
+center = [1.1, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+medium = "fog"
+[[quads]]
+corner = [0.9, -0.2, -0.2]
+u = [0.4, 0.0, 0.0]
+v = [0.0, 0.0, 0.4]
+material = "lamp"
+[[lights]]
+type = "point"
+position = [-1.1, 0.0, 0.0]
+intensity = 3.0
+"#;
+    assert_agree("lamps inside fog", &sized(text, 8, 0), 32);
+}
+
+/// `media_around` finds the media of the objects around a point, innermost last: a point in
+/// a sphere of fog nested in a larger one of smoke, beside a third sphere of fog that its walk
+/// out of the scene enters and leaves; a point in the smoke only; a point outside all.
+#[test]
+fn media_around_a_point_are_the_objects_that_enclose_it() {
+    let text = r#"
+[camera]
+eye = [0.0, 0.0, -9.0]
+target = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+vfov = 40
+[render]
+width = 4
+height = 4
+spp = 1
+max_bounces = 4
+[materials.boundary]
+type = "interface"
+[materials.skin]
+type = "interface"
+[media.fog]
+sigma_s = [0.5, 0.5, 0.5]
+[media.smoke]
+sigma_s = [0.1, 0.1, 0.1]
+[[spheres]]
+center = [0.0, 0.0, 0.0]
+radius = 3.0
+material = "skin"
+medium = "smoke"
+[[spheres]]
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "boundary"
+medium = "fog"
+[[spheres]]
+center = [0.5, 1.5, 1.0]
+radius = 0.4
+material = "boundary"
+medium = "fog"
+[[lights]]
+type = "point"
+position = [0.0, 0.0, 0.0]
+intensity = 1.0
+"#;
+    let scene = common::kernel_scene(text);
+    let refs = glint::cpu::scene_refs::SceneRefs::of(&scene, &scene.params);
+    // Each medium by its σs (fog 0.5, smoke 0.1): every object with a medium has a slot.
+    let around = |p: [f32; 3]| {
+        let s = media_around(&refs, glam::Vec3::from(p));
+        s.slots[..s.depth as usize]
+            .iter()
+            .map(|&slot| scene.params.media[slot as usize].sigma_s[0])
+            .collect::<Vec<f32>>()
+    };
+    assert_eq!(around([0.0, 0.0, 0.0]), vec![0.1, 0.5]);
+    assert_eq!(around([0.0, -2.0, 0.0]), vec![0.1]);
+    assert_eq!(around([0.0, 0.0, -5.0]), Vec::<f32>::new());
 }
 
 /// The kernel's bidirectional integrator has no medium vertices: a scene with media is

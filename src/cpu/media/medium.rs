@@ -119,6 +119,50 @@ pub fn medium_crossed(
     out
 }
 
+/// Surfaces [`media_around`] passes at most on its way out of the scene.
+pub const MAX_SURROUNDING_SURFACES: u32 = 16;
+
+/// The direction [`media_around`] looks along: any fixed one, skewed off the axes so that it
+/// does not graze axis-aligned walls.
+const SURROUNDINGS_DIRECTION: Vec3 = Vec3::new(0.267_261_24, 0.801_783_7, 0.534_522_5);
+
+/// The media whose objects enclose point `p` (a lamp inside a fogged box), innermost last: a
+/// ray from `p` out of the scene, through every surface, leaves each of them through a back
+/// face that it did not enter on the way. Up to [`MAX_SURROUNDING_SURFACES`] surfaces and
+/// [`MEDIUM_STACK_SIZE`] media; without a camera-like declaration, this is how a light
+/// subpath learns the medium it starts in.
+pub fn media_around(scene: &SceneRefs, p: Vec3) -> MediumStack {
+    let params = scene.params;
+    let mut ray = Ray {
+        origin: p,
+        dir: SURROUNDINGS_DIRECTION,
+    };
+    // Media entered on the way out (objects beside `p`, not around it), and those left.
+    let mut entered = MediumStack::default();
+    let mut around = MediumStack::default();
+    for _ in 0..MAX_SURROUNDING_SURFACES {
+        let hit = intersect_scene(&scene.geometry, &ray);
+        if hit.t == NO_HIT {
+            break;
+        }
+        let slot = boundary_slot(params, hit.material);
+        if slot != NO_MEDIUM {
+            if hit.front_face {
+                entered = medium_crossed(params, &entered, hit.material, true);
+            } else if entered.slots[..entered.depth as usize].contains(&slot) {
+                entered = medium_crossed(params, &entered, hit.material, false);
+            } else if (around.depth as usize) < MEDIUM_STACK_SIZE {
+                around.slots[around.depth as usize] = slot;
+                around.depth += 1;
+            }
+        }
+        ray.origin = offset_ray_origin(hit.position, hit.error, -hit.normal);
+    }
+    // Found innermost first; the stack holds the outermost first.
+    around.slots[..around.depth as usize].reverse();
+    around
+}
+
 /// An index-matched, untinted dielectric (`type = "interface"`): it only separates media, so
 /// paths and shadow rays cross it without scattering.
 pub fn is_interface(m: &Material) -> bool {

@@ -31,8 +31,8 @@ use crate::cpu::lights::emission::{
 };
 use crate::cpu::materials::material::{bsdf_eval, bsdf_pdf, bsdf_sample};
 use crate::cpu::media::medium::{
-    current_medium, is_interface, medium_crossed, medium_start, sample_flight, segment_limit,
-    transmittance, MediumStack,
+    current_medium, is_interface, media_around, medium_crossed, medium_start, sample_flight,
+    segment_limit, transmittance, MediumStack,
 };
 use crate::cpu::media::phase::{hg_phase, sample_hg};
 use crate::cpu::scene_refs::SceneRefs;
@@ -531,7 +531,8 @@ pub fn light_subpath(
     light.material.emission = origin.emitted.into();
     // At infinity, the density of the direction (for a sun without a disk, its selection):
     // what connecting to it divides by, and what a camera path escaping there compares.
-    light.pdf_fwd = if origin.kind == EMITTER_INFINITE || origin.kind == EMITTER_DELTA_DIRECTION {
+    let at_infinity = origin.kind == EMITTER_INFINITE || origin.kind == EMITTER_DELTA_DIRECTION;
+    light.pdf_fwd = if at_infinity {
         origin.pdf_direction
     } else {
         origin.pdf_position
@@ -542,17 +543,22 @@ pub fn light_subpath(
         1.0
     };
     light.beta = origin.emitted / origin.pdf_position;
+    let start = if origin.kind == EMITTER_AREA {
+        offset_ray_origin(origin.hit.position, origin.hit.error, origin.hit.normal)
+    } else {
+        origin.hit.position
+    };
+    // A finite emitter starts in the media of the objects around it; light from infinity in
+    // the global medium.
+    if params.medium_count > 0 && !at_infinity {
+        light.media = media_around(scene, start);
+    }
     path[0] = light;
     let max_vertices = (params.max_bounces as usize + 1).min(LIGHT_VERTICES);
     if max_vertices < 2 {
         return 1;
     }
     let beta = origin.emitted * (cos / (origin.pdf_position * origin.pdf_direction));
-    let start = if origin.kind == EMITTER_AREA {
-        offset_ray_origin(origin.hit.position, origin.hit.error, origin.hit.normal)
-    } else {
-        origin.hit.position
-    };
     let ray = Ray {
         origin: start,
         dir: origin.dir,
@@ -562,7 +568,7 @@ pub fn light_subpath(
         ray,
         beta: beta * light_media_transmittance(scene, origin.kind),
         pdf_dir: origin.pdf_direction,
-        media: MediumStack::default(),
+        media: light.media,
         segment: 0,
     };
     random_walk(
@@ -578,10 +584,8 @@ pub fn light_subpath(
     )
 }
 
-/// Light subpaths start in the global medium (an empty stack): emitters are taken to lie
-/// outside every medium an object bounds (a light inside a fogged box would start its walk
-/// in the global medium instead; connections, traced from the camera side, are right
-/// regardless). Light from infinity crosses a homogeneous global medium of infinite extent,
+/// Light from infinity starts its subpath in the global medium (an empty stack; a finite
+/// emitter in the media around it, `media_around`). It crosses a homogeneous global medium of infinite extent,
 /// as the path tracer's shadow rays to it do: its transmittance is 0 in every channel that
 /// attenuates.
 fn light_media_transmittance(scene: &SceneRefs, kind: u32) -> Vec3 {
