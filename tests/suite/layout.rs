@@ -462,7 +462,8 @@ fn uniform_scene_kernel_declares_the_uploaded_sizes() {
     }
 }
 
-/// A kernel without media carries none of the media's code, only media/no_media.wgsl's stubs:
+/// A kernel without media carries none of the media's code, only media/no_media.wgsl's stubs
+/// (of the phase function too: bidirectional's vertices name it):
 /// behind a constant `false`, lavapipe still translated and inlined it for every kernel it built
 /// (docs/src/performance/history/2026-12-04-media-free-cost.md).
 #[test]
@@ -482,7 +483,8 @@ fn kernels_without_media_carry_only_the_media_stubs() {
         "// ---- media/medium.wgsl",
         "// ---- integrator/path_media.wgsl",
         "fn sample_free_flight(",
-        "fn hg_phase(",
+        "fn segment_transmittance(",
+        "fn ray_end_distance(",
     ] {
         assert!(with.contains(part), "{part} missing with media");
         assert!(!without.contains(part), "{part} present without media");
