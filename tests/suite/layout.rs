@@ -383,6 +383,11 @@ fn wgsl_constants_match_the_hosts() {
         ("VERTEX_CAMERA", v::VERTEX_CAMERA),
         ("VERTEX_LIGHT", v::VERTEX_LIGHT),
         ("VERTEX_SURFACE", v::VERTEX_SURFACE),
+        ("VERTEX_MEDIUM", v::VERTEX_MEDIUM),
+        (
+            "CONNECTION_TRACKING",
+            glint::cpu::integrator::bdpt::connect::CONNECTION_TRACKING,
+        ),
         ("BDPT_MAX_BOUNCES", w::BDPT_MAX_BOUNCES),
         ("CAMERA_VERTICES", w::CAMERA_VERTICES as u32),
         ("LIGHT_VERTICES", w::LIGHT_VERTICES as u32),
