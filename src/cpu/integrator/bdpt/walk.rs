@@ -123,7 +123,7 @@ struct Walk {
 }
 
 /// Segments a walk traces at most: every vertex's, and interfaces between them.
-fn segment_limit(max_vertices: usize) -> u32 {
+pub fn segment_limit(max_vertices: usize) -> u32 {
     4 * max_vertices as u32 + 8
 }
 
