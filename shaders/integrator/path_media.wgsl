@@ -8,15 +8,7 @@ fn free_flight(path: ptr<function, PathState>, t_hit: f32, pixel: u32, sample: u
         return FreeFlight(t_hit, vec3<f32>(1.0), false);
     }
     var rng = rng_stream(pixel, sample, stream_id((*path).bounce, PURPOSE_FREE_FLIGHT), params.seed, params.sampler);
-    let m = params.media[slot];
-    var flight: FreeFlight;
-    if HAS_GRID_MEDIA && m.grid != NO_GRID {
-        flight = grid_free_flight(m, (*path).ray, t_hit, &rng);
-    } else {
-        let u_channel = rng_next(&rng);
-        let u_distance = rng_next(&rng);
-        flight = sample_free_flight(m, t_hit, u_channel, u_distance);
-    }
+    let flight = sample_flight(slot, (*path).ray, t_hit, &rng);
     (*path).throughput *= flight.weight;
     return flight;
 }

@@ -126,10 +126,81 @@ fn sample_free_flight(m: Medium, t_max: f32, u_channel: f32, u_distance: f32) ->
     return FreeFlight(t_max, weight, false);
 }
 
+// A free flight through medium slot `slot` (NO_MEDIUM: none) along `ray` towards a surface at
+// t_hit (NO_HIT: none), from the flight's stream *rng: delta tracking in a grid medium, closed
+// form in a homogeneous one. Shared by the path tracer and both of bidirectional's subpaths.
+fn sample_flight(slot: u32, ray: Ray, t_hit: f32, rng: ptr<function, Rng>) -> FreeFlight {
+    if slot == NO_MEDIUM {
+        return FreeFlight(t_hit, vec3<f32>(1.0), false);
+    }
+    let m = params.media[slot];
+    if HAS_GRID_MEDIA && m.grid != NO_GRID {
+        return grid_free_flight(m, ray, t_hit, rng);
+    }
+    let u_channel = rng_next(rng);
+    let u_distance = rng_next(rng);
+    return sample_free_flight(m, t_hit, u_channel, u_distance);
+}
+
+// Where a ray through the media ends (the CPU's `end` closures of transmittance_along): at the
+// sampled light (primitive, index) of a shadow ray (PRIMITIVE_ENVIRONMENT also ends a join at
+// infinity), or, where primitive is RAY_END_POINT, at `point`, or wherever a surface is met
+// within `slack` short of it (bidirectional's joins).
+struct RayEnd {
+    primitive: u32,
+    index: u32,
+    point: vec3<f32>,
+    slack: f32,
+}
+
+const RAY_END_POINT: u32 = 0xffffffffu;
+
+// The distance of the end along this piece of the ray, given its first hit; negative where the
+// hit comes first.
+fn ray_end_distance(end: RayEnd, ray: Ray, hit: Hit) -> f32 {
+    if end.primitive == RAY_END_POINT {
+        let t_end = max(dot(end.point - ray.origin, ray.dir), 0.0);
+        if hit.t >= t_end - end.slack {
+            return t_end;
+        }
+        return -1.0;
+    }
+    if end.primitive == PRIMITIVE_ENVIRONMENT {
+        if hit.t == NO_HIT {
+            return NO_HIT;
+        }
+    } else if end.primitive == PRIMITIVE_LIGHT {
+        let l = lights[end.index];
+        if l.kind == LIGHT_SUN {
+            if hit.t == NO_HIT {
+                return NO_HIT;
+            }
+        } else {
+            let t = dot(l.position - ray.origin, ray.dir);
+            if hit.t >= t {
+                return t;
+            }
+        }
+    } else if hit.t != NO_HIT && hit.primitive == end.primitive && hit.index == end.index {
+        return hit.t;
+    }
+    return -1.0;
+}
+
 // The transmittance from the shadow ray's origin (in the media of stack) to the sampled light,
 // through interfaces; zero where anything else blocks it. Uses the alpha key the caller set.
 // Grid media's segments are ratio tracked, drawing from the vertex's PURPOSE_TRACKING stream.
 fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack, pixel: u32, sample: u32, bounce: u32) -> vec3<f32> {
+    let end = RayEnd(light.primitive, light.index, vec3<f32>(0.0), 0.0);
+    return transmittance_along(shadow, stack, end, pixel, sample, bounce, true);
+}
+
+// The transmittance along `shadow` (from the media of stack) to `end`: interfaces before it are
+// crossed (the stack follows them, as a path's would), anything else blocks. Shared by
+// next-event estimation's shadow rays and bidirectional's joins; count_segments: the crossings
+// count as segments traced (the path tracer's; the CPU's bidirectional joins pass a counter
+// they drop). Uses the alpha key the caller set.
+fn transmittance_along(shadow: Ray, stack: MediumStack, end: RayEnd, pixel: u32, sample: u32, bounce: u32, count_segments: bool) -> vec3<f32> {
     var tracking: Rng;
     if HAS_GRID_MEDIA {
         tracking = rng_stream(pixel, sample, stream_id(bounce, PURPOSE_TRACKING), params.seed, params.sampler);
@@ -138,33 +209,14 @@ fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack, pix
     var media = stack;
     var through = vec3<f32>(1.0);
     for (var i = 0u; i < MAX_SHADOW_CROSSINGS; i++) {
-        if i > 0u {
+        if i > 0u && count_segments {
             segments += 1u;
         }
         let hit = intersect_scene(ray);
-        var t_light = -1.0;
-        if light.primitive == PRIMITIVE_ENVIRONMENT {
-            if hit.t == NO_HIT {
-                t_light = NO_HIT;
-            }
-        } else if light.primitive == PRIMITIVE_LIGHT {
-            let l = lights[light.index];
-            if l.kind == LIGHT_SUN {
-                if hit.t == NO_HIT {
-                    t_light = NO_HIT;
-                }
-            } else {
-                let t = dot(l.position - ray.origin, ray.dir);
-                if hit.t >= t {
-                    t_light = t;
-                }
-            }
-        } else if hit.t != NO_HIT && hit.primitive == light.primitive && hit.index == light.index {
-            t_light = hit.t;
-        }
+        let t_end = ray_end_distance(end, ray, hit);
         let slot = current_medium(media);
-        if t_light >= 0.0 {
-            return through * segment_transmittance(slot, ray, t_light, &tracking);
+        if t_end >= 0.0 {
+            return through * segment_transmittance(slot, ray, t_end, &tracking);
         }
         if hit.t == NO_HIT || !is_interface(materials[hit.material]) {
             return vec3<f32>(0.0);

@@ -102,12 +102,27 @@ pub fn hardware_loop_iterations_per_ray(scene: &KernelScene) -> u64 {
 /// (B + 2)(B + 3) / 2 joins in all; each traces at most one shadow ray, looks among the lights
 /// for sun disks at most four times (densities at infinity), and weighs itself in two loops of
 /// at most B + 2 iterations together. Then the splat and the sample loops and the end's probe.
+///
+/// In media a walk also crosses interfaces, segments without a vertex: each subpath traces at
+/// most its segment limit (`media::medium::segment_limit`), each segment and join may look a medium up
+/// (`MEDIA_LOOPS`), and a join casts one ray per interface it crosses, up to
+/// `MAX_SHADOW_CROSSINGS`.
 pub fn bdpt_loop_iterations_per_sample(params: &Params, per_ray: u64) -> u64 {
+    use crate::cpu::media::medium::segment_limit;
     let b = params.max_bounces as u64;
     let lights = params.light_count as u64;
-    let walks = (2 * b + 1) * (per_ray + 2 * lights + 1);
     let joins = (b + 2) * (b + 3) / 2;
-    let per_join = per_ray + 4 * lights + (b + 2) + 1;
+    let weights = 4 * lights + (b + 2) + 1;
+    let (walks, per_join) = if params.medium_count > 0 {
+        let segments = segment_limit(b as u32 + 2) as u64 + segment_limit(b as u32 + 1) as u64;
+        let crossings = crate::cpu::media::medium::MAX_SHADOW_CROSSINGS as u64;
+        (
+            segments * (per_ray + 2 * lights + 1 + MEDIA_LOOPS),
+            crossings * (per_ray + MEDIA_LOOPS) + MEDIA_LOOPS + weights,
+        )
+    } else {
+        ((2 * b + 1) * (per_ray + 2 * lights + 1), per_ray + weights)
+    };
     walks + (b + 2) + joins * per_join + 1 + 2
 }
 
@@ -121,15 +136,18 @@ fn path_segments(params: &Params) -> u64 {
     params.max_bounces as u64 + 1
 }
 
+/// The loop iterations of crossing a medium boundary (shaders/media/medium.wgsl): the lookup
+/// of its slot among the 8, and the stack's shift (4 × 4 at most).
+const MEDIA_LOOPS: u64 = 8 + 4 * 4;
+
 fn sample_iterations(params: &Params, per_ray: u64) -> u64 {
     let segments = path_segments(params);
     if params.medium_count > 0 {
         // Media (shaders/media/medium.wgsl): a shadow ray casts one ray per interface it
         // crosses, and each crossing looks its medium up among the slots and the stack.
         let crossings = crate::cpu::media::medium::MAX_SHADOW_CROSSINGS as u64;
-        let media_loops = 8 + 4 * 4;
         return segments
-            * ((1 + crossings) * (per_ray + media_loops) + params.light_count as u64 + 1);
+            * ((1 + crossings) * (per_ray + MEDIA_LOOPS) + params.light_count as u64 + 1);
     }
     segments * (2 * per_ray + params.light_count as u64 + 1)
 }

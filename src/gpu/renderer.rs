@@ -70,18 +70,6 @@ fn default_variant(ctx: &GpuContext, scene: &KernelScene) -> KernelVariant {
     KernelVariant::default_for(scene, max_uniform)
 }
 
-/// The one combination the kernel refuses: its BDPT has no medium vertices yet (the CPU
-/// reference has them, `src/cpu/integrator/bdpt/`).
-pub const BDPT_MEDIA_ON_GPU: &str = "the GPU kernel's bdpt integrator does not render \
-     participating media yet; render without --gpu (bdpt then runs on the CPU reference) or \
-     use the \"path\" integrator";
-
-/// Why the kernel cannot render `scene` as its parameters say, if it cannot.
-pub fn kernel_refuses(scene: &KernelScene) -> Option<&'static str> {
-    (scene.params.integrator == INTEGRATOR_BDPT && scene.params.medium_count > 0)
-        .then_some(BDPT_MEDIA_ON_GPU)
-}
-
 impl<'a> GpuRenderer<'a> {
     /// A renderer for `scene` with the fastest kernel for it: its objects in uniform buffers
     /// when they fit the device's limit (storage buffers otherwise), and only the features it
@@ -163,9 +151,6 @@ impl<'a> GpuRenderer<'a> {
             return Err(anyhow!(
                 "the kernel variant {variant:?} lacks features the scene uses"
             ));
-        }
-        if let Some(why) = kernel_refuses(scene) {
-            return Err(anyhow!("{why}"));
         }
         let device = &ctx.device;
         let params = scene.params;

@@ -88,18 +88,7 @@ pub fn run(options: ViewOptions) -> Result<()> {
     }
     // Built once here (the BVH, the environment map's tables), and again only when the scene
     // file changes; a camera move rewrites the camera's parameters alone.
-    let mut kernel = scene.try_kernel_scene()?;
-    let mut scene = scene;
-    if let Some(why) = crate::gpu::renderer::kernel_refuses(&kernel) {
-        // The window renders with the kernel: what it cannot, it shows with path tracing, the
-        // same image in expectation.
-        crate::errln!(
-            "glint view: note: {}: {why}; the window renders it with path tracing",
-            options.scene.display()
-        );
-        scene.render.integrator = crate::scene::Integrator::Path;
-        kernel.params.integrator = crate::scene::Integrator::Path.kernel_value();
-    }
+    let kernel = scene.try_kernel_scene()?;
     let event_loop = winit::event_loop::EventLoop::new().map_err(|e| {
         InputError(format!(
             "no display: glint view cannot connect to the window system ({e}); {NO_DISPLAY_HINT}"

@@ -91,8 +91,18 @@ pub(crate) fn assert_agree_with_path_spp(
     path_spp: u32,
     renderer: MakeRenderer,
 ) {
-    let path = batch_means(scene, INTEGRATOR_PATH, path_spp, renderer);
-    let bdpt = batch_means(scene, INTEGRATOR_BDPT, spp, renderer);
+    assert_agree_with_path_by(name, scene, (spp, renderer), (path_spp, renderer));
+}
+
+/// [`assert_agree`] with bidirectional's samples per pixel and renderer, and path tracing's.
+pub(crate) fn assert_agree_with_path_by(
+    name: &str,
+    scene: &KernelScene,
+    bdpt: (u32, MakeRenderer),
+    path: (u32, MakeRenderer),
+) {
+    let path = batch_means(scene, INTEGRATOR_PATH, path.0, path.1);
+    let bdpt = batch_means(scene, INTEGRATOR_BDPT, bdpt.0, bdpt.1);
     let z = compare(&path.0, &bdpt.0, Some((&path.1, &bdpt.1)))
         .unwrap()
         .z_test
@@ -447,7 +457,17 @@ fn gpu_scenes(size: u32, seed: u32) -> Vec<(&'static str, KernelScene)> {
 /// lavapipe takes tens of seconds to compile a bidirectional kernel with a cold shader cache,
 /// and milliseconds to render these few pixels, so the tests compile it once.
 fn gpu_test_variant() -> KernelVariant {
-    let features = gpu_scenes(4, 1)
+    variant_for_all(&gpu_scenes(4, 1))
+}
+
+fn gpu_renderer<'a>(ctx: &'a glint::gpu::GpuContext, scene: &KernelScene) -> GpuRenderer<'a> {
+    GpuRenderer::with_variant(ctx, scene, gpu_test_variant()).unwrap()
+}
+
+/// One kernel with the features all of `scenes` use (storage buffers), for tests that compile
+/// it once for them all.
+pub(crate) fn variant_for_all(scenes: &[(&str, KernelScene)]) -> KernelVariant {
+    let features = scenes
         .iter()
         .map(|(_, scene)| KernelFeatures::of(scene))
         .reduce(|a, b| a.union(&b))
@@ -458,17 +478,15 @@ fn gpu_test_variant() -> KernelVariant {
     }
 }
 
-fn gpu_renderer<'a>(ctx: &'a glint::gpu::GpuContext, scene: &KernelScene) -> GpuRenderer<'a> {
-    GpuRenderer::with_variant(ctx, scene, gpu_test_variant()).unwrap()
-}
-
-/// One render of `spp` samples per pixel on the CPU and on the GPU: their accumulations.
-fn both_accumulations(
+/// One render of `spp` samples per pixel on the CPU and on the GPU (with `variant`'s kernel):
+/// their accumulations.
+pub(crate) fn both_accumulations(
     ctx: &glint::gpu::GpuContext,
     scene: &KernelScene,
     spp: u32,
+    variant: KernelVariant,
 ) -> (Accumulation, Accumulation) {
-    let mut gpu = gpu_renderer(ctx, scene);
+    let mut gpu = GpuRenderer::with_variant(ctx, scene, variant).unwrap();
     gpu.add_samples(spp).unwrap();
     (render(scene, &[spp]), gpu.read_accumulation().unwrap())
 }
@@ -486,7 +504,7 @@ fn camera_image(a: &Accumulation) -> Image {
 /// how many pixels' splat values agree to 1e-3 of their scale (as `PathAgreement` compares
 /// paths), of the pixels either film has light in.
 #[derive(Debug, Default)]
-struct SplatAgreement {
+pub(crate) struct SplatAgreement {
     same_words: usize,
     words: usize,
     agree: usize,
@@ -534,14 +552,26 @@ impl SplatAgreement {
 #[test]
 fn gpu_and_cpu_trace_the_same_bidirectional_paths() {
     let Some(ctx) = common::gpu() else { return };
+    assert_gpu_traces_the_cpus_paths(ctx, &gpu_scenes, gpu_test_variant());
+}
+
+/// The check of [`gpu_and_cpu_trace_the_same_bidirectional_paths`] on `scenes` (by seed: 1
+/// and 2, at 32²), rendered with `variant`'s kernel.
+pub(crate) fn assert_gpu_traces_the_cpus_paths(
+    ctx: &glint::gpu::GpuContext,
+    scenes: &dyn Fn(u32, u32) -> Vec<(&'static str, KernelScene)>,
+    variant: KernelVariant,
+) {
     let mut paths = common::PathAgreement::default();
     let mut splats = SplatAgreement::default();
     for seed in [1, 2] {
-        for (name, scene) in gpu_scenes(32, seed) {
-            let (cpu, gpu) = both_accumulations(ctx, &scene, 1);
+        for (name, scene) in scenes(32, seed) {
+            let (cpu, gpu) = both_accumulations(ctx, &scene, 1, variant);
             let mut one = SplatAgreement::default();
             one.add(&cpu, &gpu);
-            eprintln!("{name}, seed {seed}: splats {one:?}");
+            let mut one_paths = common::PathAgreement::default();
+            one_paths.add(&camera_image(&cpu), &camera_image(&gpu));
+            eprintln!("{name}, seed {seed}: splats {one:?}, paths {one_paths:?}");
             paths.add(&camera_image(&cpu), &camera_image(&gpu));
             splats.add(&cpu, &gpu);
         }

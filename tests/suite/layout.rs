@@ -383,6 +383,11 @@ fn wgsl_constants_match_the_hosts() {
         ("VERTEX_CAMERA", v::VERTEX_CAMERA),
         ("VERTEX_LIGHT", v::VERTEX_LIGHT),
         ("VERTEX_SURFACE", v::VERTEX_SURFACE),
+        ("VERTEX_MEDIUM", v::VERTEX_MEDIUM),
+        (
+            "CONNECTION_TRACKING",
+            glint::cpu::integrator::bdpt::connect::CONNECTION_TRACKING,
+        ),
         ("BDPT_MAX_BOUNCES", w::BDPT_MAX_BOUNCES),
         ("CAMERA_VERTICES", w::CAMERA_VERTICES as u32),
         ("LIGHT_VERTICES", w::LIGHT_VERTICES as u32),
@@ -462,7 +467,8 @@ fn uniform_scene_kernel_declares_the_uploaded_sizes() {
     }
 }
 
-/// A kernel without media carries none of the media's code, only media/no_media.wgsl's stubs:
+/// A kernel without media carries none of the media's code, only media/no_media.wgsl's stubs
+/// (of the phase function too: bidirectional's vertices name it):
 /// behind a constant `false`, lavapipe still translated and inlined it for every kernel it built
 /// (docs/src/performance/history/2026-12-04-media-free-cost.md).
 #[test]
@@ -482,7 +488,8 @@ fn kernels_without_media_carry_only_the_media_stubs() {
         "// ---- media/medium.wgsl",
         "// ---- integrator/path_media.wgsl",
         "fn sample_free_flight(",
-        "fn hg_phase(",
+        "fn segment_transmittance(",
+        "fn ray_end_distance(",
     ] {
         assert!(with.contains(part), "{part} missing with media");
         assert!(!without.contains(part), "{part} present without media");

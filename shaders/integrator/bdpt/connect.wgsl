@@ -6,7 +6,7 @@
 // Strategies: s = 0, the camera subpath found an emitter (or the sky); s = 1, a camera vertex
 // joined to a light point (next-event estimation's, resampled); t = 1, a light vertex seen
 // through the camera, splatted into whatever pixel it lands in (light tracing); every other
-// (s, t) joins two surface vertices. t = 0 (a light path that hits the lens) is not a strategy
+// (s, t) joins two scattering vertices (surfaces, or points in a medium). t = 0 (a light path that hits the lens) is not a strategy
 // here: the lens cannot be hit.
 //
 // The subpaths are walk.wgsl's camera_path and light_path. Where the CPU passes a strategy's
@@ -54,6 +54,48 @@ fn segment_clear(a: BdptVertex, b: BdptVertex, id: SampleId, s: u32, t: u32) -> 
     // rounding.
     return unoccluded_before(Ray(start, to_end / distance), distance * (1.0 - SHADOW_EPSILON));
 }
+
+// The fraction of the light that gets from camera-side vertex `a` to vertex `b` (one may be at
+// infinity): 0 or 1 without media (segment_clear); with media, the transmittance along the
+// join, crossing interfaces with the medium stack following them. It starts from `a`, whose
+// stack is the camera subpath's own (so right even where a light subpath's assumed start medium
+// is not).
+fn segment_through(a: BdptVertex, b: BdptVertex, id: SampleId, s: u32, t: u32) -> vec3<f32> {
+    if !HAS_MEDIA || params.medium_count == 0u {
+        return select(vec3<f32>(0.0), vec3<f32>(1.0), segment_clear(a, b, id, s, t));
+    }
+    keyed_connection(id, s, t);
+    let dir = direction_between(a, b);
+    let start = off_surface(a, dir);
+    let media = stack_towards(a, dir);
+    // To infinity: a join ends where the ray escapes, as a shadow ray to the sky does.
+    var ray = Ray(start, dir);
+    var end = RayEnd(PRIMITIVE_ENVIRONMENT, 0u, vec3<f32>(0.0), 0.0);
+    if !is_infinite(b) {
+        let end_point = off_surface(b, -dir);
+        let to_end = end_point - start;
+        let distance = length(to_end);
+        if distance <= 0.0 {
+            return vec3<f32>(0.0);
+        }
+        ray = Ray(start, to_end / distance);
+        // As segment_clear: short of the far end by a sliver of the join's length.
+        end = RayEnd(RAY_END_POINT, 0u, end_point, distance * SHADOW_EPSILON);
+    }
+    return transmittance_along(ray, media, end, id.pixel, id.sample, CONNECTION_TRACKING + s * 32u + t, false);
+}
+
+// The media a ray from vertex v along dir starts in: the vertex's, crossed into the medium its
+// surface bounds where dir goes through it.
+fn stack_towards(v: BdptVertex, dir: vec3<f32>) -> MediumStack {
+    if v.kind == VERTEX_SURFACE && dot(dir, v.hit.normal) < 0.0 {
+        return medium_crossed(v.media, v.hit.material, v.hit.front_face);
+    }
+    return v.media;
+}
+
+// The first "bounce" of joins' ratio-tracking streams: above both subpaths'.
+const CONNECTION_TRACKING: u32 = 131072u;
 
 // The fraction of a join's length left unsearched at its far end (pbrt's ShadowEpsilon).
 const SHADOW_EPSILON: f32 = 1e-4;
@@ -132,11 +174,21 @@ fn direct_light(pt: BdptVertex, m_pt: Material, t: u32, id: SampleId) -> DirectL
     }
     keyed_connection(id, 1u, t);
     let origin = off_surface(pt, light.dir);
-    if !light_visible(Ray(origin, light.dir), light) {
+    let shadow = Ray(origin, light.dir);
+    var through = vec3<f32>(1.0);
+    if HAS_MEDIA && params.medium_count > 0u {
+        // Through the media as the path tracer's next-event estimation sees them.
+        let media = stack_towards(pt, light.dir);
+        let end = RayEnd(light.primitive, light.index, vec3<f32>(0.0), 0.0);
+        through = transmittance_along(shadow, media, end, id.pixel, id.sample, CONNECTION_TRACKING + 32u + t, false);
+        if all(through == vec3<f32>(0.0)) {
+            return out;
+        }
+    } else if !light_visible(shadow, light) {
         return out;
     }
     out.vertex = v;
-    out.radiance = pt.beta * f * light.radiance / light.pdf;
+    out.radiance = pt.beta * f * through * light.radiance / light.pdf;
     out.found = true;
     return out;
 }
@@ -185,8 +237,8 @@ fn emitter_point(primitive: u32, index: u32, p: vec3<f32>, probe: vec3<f32>, dir
 // The radiance strategy (s, t) adds, unweighted; t = 1 also says where it lands, and sets
 // *lens to its lens vertex. m_pt and m_qs are the materials of the joined surface vertices
 // (connect's, where they are surfaces). Written with one call each of the adjoint BSDF and
-// the shadow test for light tracing and the surface joins alike (the CPU has two of each):
-// lavapipe inlines every call, and its compile time grows with the copies.
+// the join's transmittance for light tracing and the other joins alike (the CPU has two of
+// each): lavapipe inlines every call, and its compile time grows with the copies.
 fn unweighted(s: u32, t: u32, id: SampleId, lens: ptr<function, BdptVertex>, m_pt: Material, m_qs: Material) -> Connection {
     var out = no_connection();
     if s == 0u {
@@ -207,7 +259,7 @@ fn unweighted(s: u32, t: u32, id: SampleId, lens: ptr<function, BdptVertex>, m_p
     var view: CameraView;
     if t == 1u {
         // Light tracing: the light vertex seen through the lens.
-        if qs.delta || params.projection == PROJECTION_ORTHOGRAPHIC || qs.kind != VERTEX_SURFACE {
+        if qs.delta || params.projection == PROJECTION_ORTHOGRAPHIC || !scatters(qs) {
             return out;
         }
         var lens_rng = rng_stream(id.pixel, id.sample, stream_id(LIGHT_SUBPATH + s, PURPOSE_LIGHT), params.seed, params.sampler);
@@ -220,12 +272,13 @@ fn unweighted(s: u32, t: u32, id: SampleId, lens: ptr<function, BdptVertex>, m_p
         camera.kind = VERTEX_CAMERA;
         camera.hit.position = view.lens_point;
         camera.beta = vec3<f32>(1.0);
+        camera.media = medium_start();
         *lens = camera;
         toward = -view.dir;
         other = camera;
     } else {
         let pt = camera_path[t - 1u];
-        if pt.kind != VERTEX_SURFACE || pt.delta {
+        if !scatters(pt) || pt.delta {
             return out;
         }
         let to_light = direction_between(pt, qs);
@@ -234,7 +287,7 @@ fn unweighted(s: u32, t: u32, id: SampleId, lens: ptr<function, BdptVertex>, m_p
             return out;
         }
         // s >= 2 (s = 1 is next-event estimation's, in connect).
-        if qs.delta || qs.kind != VERTEX_SURFACE {
+        if qs.delta || !scatters(qs) {
             return out;
         }
         toward = -to_light;
@@ -257,18 +310,12 @@ fn unweighted(s: u32, t: u32, id: SampleId, lens: ptr<function, BdptVertex>, m_p
             return out;
         }
     }
-    // The shadow ray: from the light vertex to the lens, or from the camera vertex to the
-    // light vertex (the CPU's directions, so the same ray).
-    var a = other;
-    var b = qs;
-    if t == 1u {
-        a = qs;
-        b = other;
-    }
-    if !segment_clear(a, b, id, s, t) {
+    // The join, traced from the camera side (the lens, or the camera vertex), as the CPU's.
+    let through = segment_through(other, qs, id, s, t);
+    if all(through == vec3<f32>(0.0)) {
         return out;
     }
-    out.radiance = radiance;
+    out.radiance = radiance * through;
     out.view = view;
     out.has_view = t == 1u;
     return out;
@@ -434,7 +481,7 @@ fn connect(s: u32, t: u32, id: SampleId, weighted: bool) -> Connection {
     }
     var radiance: vec3<f32>;
     if s == 1u {
-        if pt.kind != VERTEX_SURFACE || pt.delta {
+        if !scatters(pt) || pt.delta {
             return out;
         }
         let direct = direct_light(pt, m_pt, t, id);

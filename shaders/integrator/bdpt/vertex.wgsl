@@ -9,14 +9,18 @@ const VERTEX_CAMERA: u32 = 0u;
 const VERTEX_LIGHT: u32 = 1u;
 // A surface a subpath met (an emitter among them: a camera subpath may end on one).
 const VERTEX_SURFACE: u32 = 2u;
+// A scattering event in a participating medium: its "BSDF" is the medium's phase function
+// (f = pdf = phase, no cosine anywhere: a point in a volume has no area).
+const VERTEX_MEDIUM: u32 = 3u;
 
-// The CPU's BdptVertex without its two fields that only fill memory: `material` (the vertex's
-// material, textures and vertex colours applied) is made again from hit.material, hit.uv and the
-// triangle's barycentrics where it is needed (vertex_material: the same numbers, so the same
-// material), and `emitted` is written there and never read. A subpath holds up to 26 of these
+// The CPU's BdptVertex without its three fields that only fill memory: `material` (the
+// vertex's material, textures and vertex colours applied) is made again from hit.material,
+// hit.uv and the triangle's barycentrics where it is needed (vertex_material: the same numbers,
+// so the same material), `g` (a medium vertex's phase asymmetry) from its medium stack
+// (medium_g), and `emitted` is written there and never read. A subpath holds up to 26 of these
 // per invocation (walk.wgsl), so the 40 words of a material are most of what is saved.
 struct BdptVertex {
-    // VERTEX_CAMERA, VERTEX_LIGHT or VERTEX_SURFACE.
+    // VERTEX_CAMERA, VERTEX_LIGHT, VERTEX_SURFACE or VERTEX_MEDIUM.
     kind: u32,
     // For light vertices: EMITTER_AREA, EMITTER_POINT, EMITTER_INFINITE or
     // EMITTER_DELTA_DIRECTION (lights/emission.wgsl).
@@ -38,6 +42,9 @@ struct BdptVertex {
     pdf_rev: f32,
     // The vertex scattered by a delta lobe: no connection can end at it.
     delta: bool,
+    // The media the subpath's ray arriving at the vertex was in (media/medium.wgsl; one empty
+    // word in kernels without media); a join leaving through the surface crosses it first.
+    media: MediumStack,
 }
 
 // The material at a surface vertex, as the walk that made it found it.
@@ -47,6 +54,17 @@ fn vertex_material(v: BdptVertex) -> Material {
 
 fn is_infinite(v: BdptVertex) -> bool {
     return v.kind == VERTEX_LIGHT && (v.emitter == EMITTER_INFINITE || v.emitter == EMITTER_DELTA_DIRECTION);
+}
+
+// A surface or medium vertex: one that scatters, where joins can end. (Medium vertices only
+// where the kernel has media: elsewhere the test is the surface's alone.)
+fn scatters(v: BdptVertex) -> bool {
+    return v.kind == VERTEX_SURFACE || (HAS_MEDIA && v.kind == VERTEX_MEDIUM);
+}
+
+// A medium vertex's Henyey-Greenstein asymmetry: its medium's, the innermost of its stack.
+fn medium_g(v: BdptVertex) -> f32 {
+    return params.media[current_medium(v.media)].g;
 }
 
 // Whether the vertex has an area (its density converts with the cosine there).
@@ -111,6 +129,16 @@ fn surface_pdf(v: BdptVertex, m: Material, wo: vec3<f32>, wi: vec3<f32>) -> f32 
     return bsdf_pdf(m, wo, wi, f.n, f.coat_n, f.front_face);
 }
 
+// The solid-angle density of either subpath's sampling at scattering vertex v (a surface's BSDF
+// of material m, a medium's phase function) producing wi for light leaving along wo.
+fn scatter_pdf(v: BdptVertex, m: Material, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if HAS_MEDIA && v.kind == VERTEX_MEDIUM {
+        // The phase function's cosine is between the travelled and the scattered direction.
+        return hg_phase(medium_g(v), -dot(wo, wi));
+    }
+    return surface_pdf(v, m, wo, wi);
+}
+
 // The density with which a light vertex v sends its light to `next`: what the light subpath's
 // first segment would have drawn.
 fn light_direction_density(v: BdptVertex, next: BdptVertex) -> f32 {
@@ -146,7 +174,7 @@ fn light_origin_density(v: BdptVertex) -> f32 {
 
 // The density with which vertex v (material m, for a surface), reached from `prev` (ignored
 // at the subpath's ends, and where has_prev is false), samples `next`: the camera's density, a
-// light's emission density or the BSDF's, as a density at `next`.
+// light's emission density, the BSDF's or the phase function's, as a density at `next`.
 fn density_to(v: BdptVertex, m: Material, prev: BdptVertex, has_prev: bool, next: BdptVertex) -> f32 {
     if v.kind == VERTEX_CAMERA {
         if params.projection == PROJECTION_ORTHOGRAPHIC {
@@ -169,5 +197,5 @@ fn density_to(v: BdptVertex, m: Material, prev: BdptVertex, has_prev: bool, next
     }
     let wo = direction_between(v, prev);
     let wi = direction_between(v, next);
-    return to_area_density(surface_pdf(v, m, wo, wi), v, next);
+    return to_area_density(scatter_pdf(v, m, wo, wi), v, next);
 }

@@ -152,27 +152,23 @@ impl App {
     }
 
     /// A reloaded scene, rendered by the integrator switched to unless the file's own changed;
-    /// where that one cannot render the new scene (bdpt in a medium, on the GPU), with path
-    /// tracing, and the title says why.
+    /// where the switched-to one cannot render the new scene (bdpt and a density grid), the
+    /// file's.
     fn keep_integrator(&mut self, scene: Scene, kernel: KernelScene) -> (Scene, KernelScene) {
         let from_file = scene.render.integrator;
-        let wanted = if from_file != self.file_integrator {
+        if from_file != self.file_integrator {
             self.file_integrator = from_file;
-            from_file
-        } else {
-            self.integrator
-        };
-        for choice in [wanted, Integrator::Path] {
-            match App::with_integrator(scene.clone(), kernel.clone(), choice) {
-                Ok(chosen) => {
-                    self.integrator = choice;
-                    return chosen;
-                }
-                Err(e) => self.refuse_integrator(choice, &e),
+            self.integrator = from_file;
+            return (scene, kernel);
+        }
+        match App::with_integrator(scene.clone(), kernel.clone(), self.integrator) {
+            Ok(switched) => switched,
+            Err(e) => {
+                self.refuse_integrator(self.integrator, &e);
+                self.integrator = from_file;
+                (scene, kernel)
             }
         }
-        self.integrator = from_file;
-        (scene, kernel)
     }
 
     /// Switches between path tracing and bidirectional path tracing (I), restarting the

@@ -225,24 +225,20 @@ impl App {
     }
 
     /// `scene` and `kernel` rendered by `integrator`: the scene's own checks decide whether it
-    /// can (bdpt traces no media and a bounded number of bounces).
+    /// can (bdpt renders no density grids and a bounded number of bounces).
     pub(super) fn with_integrator(
         scene: Scene,
         mut kernel: KernelScene,
         integrator: Integrator,
     ) -> Result<(Scene, KernelScene), String> {
-        let scene = if scene.render.integrator == integrator {
-            scene
-        } else {
-            scene.with_overrides(&RenderOverrides {
-                integrator: Some(integrator),
-                ..Default::default()
-            })?
-        };
-        kernel.params.integrator = integrator.kernel_value();
-        if let Some(why) = crate::gpu::renderer::kernel_refuses(&kernel) {
-            return Err(why.into());
+        if scene.render.integrator == integrator {
+            return Ok((scene, kernel));
         }
+        let scene = scene.with_overrides(&RenderOverrides {
+            integrator: Some(integrator),
+            ..Default::default()
+        })?;
+        kernel.params.integrator = integrator.kernel_value();
         Ok((scene, kernel))
     }
 

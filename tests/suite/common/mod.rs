@@ -199,7 +199,7 @@ pub fn assert_paths_agree(cpu: &Image, gpu: &Image, min_fraction: f64) {
 
 /// Pixel-by-pixel agreement of a CPU and a GPU render at 1 spp, where each pixel is one path
 /// (see tests/suite/gpu_vs_cpu.rs for why a small fraction may differ).
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub struct PathAgreement {
     agree: usize,
     lit: usize,

@@ -155,7 +155,7 @@ fn stack_towards(params: &Params, v: &BdptVertex, dir: Vec3) -> MediumStack {
 }
 
 /// The first "bounce" of connections' ratio-tracking streams: above both subpaths'.
-const CONNECTION_TRACKING: u32 = 1 << 17;
+pub const CONNECTION_TRACKING: u32 = 1 << 17;
 
 /// The fraction of a join's length left unsearched at its far end (pbrt's `ShadowEpsilon`).
 pub const SHADOW_EPSILON: f32 = 1e-4;
