@@ -3,6 +3,9 @@
 
 const MEDIUM_STACK_SIZE: u32 = 4u;
 const MAX_SHADOW_CROSSINGS: u32 = 8u;
+const MAX_SURROUNDING_SURFACES: u32 = 16u;
+// Any fixed direction, skewed off the axes so that it does not graze axis-aligned walls.
+const SURROUNDINGS_DIRECTION: vec3<f32> = vec3<f32>(0.26726124, 0.8017837, 0.5345225);
 
 // Segments a path or subpath of at most max_vertices vertices traces at most: its scattering
 // events' and the interfaces crossed between them, which max_bounces does not count.
@@ -193,6 +196,44 @@ fn ray_end_distance(end: RayEnd, ray: Ray, hit: Hit) -> f32 {
 fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack, pixel: u32, sample: u32, bounce: u32) -> vec3<f32> {
     let end = RayEnd(light.primitive, light.index, vec3<f32>(0.0), 0.0);
     return transmittance_along(shadow, stack, end, pixel, sample, bounce, true);
+}
+
+// The media whose objects enclose point p (a lamp inside a fogged box), innermost last: a ray
+// from p out of the scene, through every surface, leaves each of them through a back face it
+// did not enter on the way (up to MAX_SURROUNDING_SURFACES surfaces).
+fn media_around(p: vec3<f32>) -> MediumStack {
+    var ray = Ray(p, SURROUNDINGS_DIRECTION);
+    // Media entered on the way out (objects beside p, not around it), and those left.
+    var entered = MediumStack();
+    var around = MediumStack();
+    for (var i = 0u; i < MAX_SURROUNDING_SURFACES; i++) {
+        let hit = intersect_scene(ray);
+        if hit.t == NO_HIT {
+            break;
+        }
+        let slot = boundary_slot(hit.material);
+        if slot != NO_MEDIUM {
+            var inside_entered = false;
+            for (var j = 0u; j < entered.depth; j++) {
+                inside_entered = inside_entered || entered.slots[j] == slot;
+            }
+            if hit.front_face {
+                entered = medium_crossed(entered, hit.material, true);
+            } else if inside_entered {
+                entered = medium_crossed(entered, hit.material, false);
+            } else if around.depth < MEDIUM_STACK_SIZE {
+                around.slots[around.depth] = slot;
+                around.depth += 1u;
+            }
+        }
+        ray = Ray(offset_ray_origin(hit.position, hit.error, -hit.normal), ray.dir);
+    }
+    // Found innermost first; the stack holds the outermost first.
+    var out = around;
+    for (var j = 0u; j < around.depth; j++) {
+        out.slots[j] = around.slots[around.depth - 1u - j];
+    }
+    return out;
 }
 
 // The transmittance along `shadow` (from the media of stack) to `end`: interfaces before it are

@@ -64,6 +64,15 @@ struct RayEnd {
 
 const RAY_END_POINT: u32 = 0xffffffffu;
 
+// medium.wgsl's bound (bidirectional's walks name it in every kernel).
+fn segment_limit(max_vertices: u32) -> u32 {
+    return 4u * max_vertices + 8u;
+}
+
+fn media_around(p: vec3<f32>) -> MediumStack {
+    return MediumStack(0u);
+}
+
 fn transmittance_along(shadow: Ray, stack: MediumStack, end: RayEnd, pixel: u32, sample: u32, bounce: u32, count_segments: bool) -> vec3<f32> {
     return vec3<f32>(0.0);
 }

@@ -106,7 +106,8 @@ pub fn hardware_loop_iterations_per_ray(scene: &KernelScene) -> u64 {
 /// In media a walk also crosses interfaces, segments without a vertex: each subpath traces at
 /// most its segment limit (`media::medium::segment_limit`), each segment and join may look a medium up
 /// (`MEDIA_LOOPS`), and a join casts one ray per interface it crosses, up to
-/// `MAX_SHADOW_CROSSINGS`.
+/// `MAX_SHADOW_CROSSINGS`; the light subpath's start looks for the media around its emitter
+/// (`media_around`: up to `MAX_SURROUNDING_SURFACES` rays, each crossing a boundary).
 pub fn bdpt_loop_iterations_per_sample(params: &Params, per_ray: u64) -> u64 {
     use crate::cpu::media::medium::segment_limit;
     let b = params.max_bounces as u64;
@@ -116,8 +117,10 @@ pub fn bdpt_loop_iterations_per_sample(params: &Params, per_ray: u64) -> u64 {
     let (walks, per_join) = if params.medium_count > 0 {
         let segments = segment_limit(b as u32 + 2) as u64 + segment_limit(b as u32 + 1) as u64;
         let crossings = crate::cpu::media::medium::MAX_SHADOW_CROSSINGS as u64;
+        let surroundings = crate::cpu::media::medium::MAX_SURROUNDING_SURFACES as u64
+            * (per_ray + MEDIA_LOOPS + 4);
         (
-            segments * (per_ray + 2 * lights + 1 + MEDIA_LOOPS),
+            surroundings + segments * (per_ray + 2 * lights + 1 + MEDIA_LOOPS),
             crossings * (per_ray + MEDIA_LOOPS) + MEDIA_LOOPS + weights,
         )
     } else {

@@ -96,11 +96,6 @@ struct Walk {
     segment: u32,
 }
 
-// Segments a walk traces at most: every vertex's, and interfaces between them.
-fn segment_limit(max_vertices: u32) -> u32 {
-    return 4u * max_vertices + 8u;
-}
-
 // How the walk leaves a vertex (the CPU's continue_walk's `next`): along `ray` in `media`, with
 // throughput factor `weight`, drawn with solid-angle density pdf_dir (0: a delta lobe), the
 // density back being pdf_rev; ends is true where the walk ends at the vertex instead.
@@ -423,7 +418,8 @@ fn light_subpath_start(id: SampleId) -> WalkStart {
     light.dir = origin.dir;
     // At infinity, the density of the direction (for a sun without a disk, its selection):
     // what connecting to it divides by, and what a camera path escaping there compares.
-    if origin.kind == EMITTER_INFINITE || origin.kind == EMITTER_DELTA_DIRECTION {
+    let at_infinity = origin.kind == EMITTER_INFINITE || origin.kind == EMITTER_DELTA_DIRECTION;
+    if at_infinity {
         light.pdf_fwd = origin.pdf_direction;
     } else {
         light.pdf_fwd = origin.pdf_position;
@@ -433,6 +429,15 @@ fn light_subpath_start(id: SampleId) -> WalkStart {
         cos_origin = abs(dot(origin.hit.normal, origin.dir));
     }
     light.beta = origin.emitted / origin.pdf_position;
+    var start = origin.hit.position;
+    if origin.kind == EMITTER_AREA {
+        start = offset_ray_origin(origin.hit.position, origin.hit.error, origin.hit.normal);
+    }
+    // A finite emitter starts in the media of the objects around it; light from infinity in
+    // the global medium.
+    if HAS_MEDIA && params.medium_count > 0u && !at_infinity {
+        light.media = media_around(start);
+    }
     light_path[0] = light;
     out.count = 1u;
     out.max_vertices = min(params.max_bounces + 1u, LIGHT_VERTICES);
@@ -440,18 +445,13 @@ fn light_subpath_start(id: SampleId) -> WalkStart {
         return out;
     }
     let beta = origin.emitted * (cos_origin / (origin.pdf_position * origin.pdf_direction));
-    var start = origin.hit.position;
-    if origin.kind == EMITTER_AREA {
-        start = offset_ray_origin(origin.hit.position, origin.hit.error, origin.hit.normal);
-    }
     let ray = Ray(start, origin.dir);
-    out.walk = Walk(ray, beta * light_media_transmittance(origin.kind), origin.pdf_direction, MediumStack(), 0u);
+    out.walk = Walk(ray, beta * light_media_transmittance(origin.kind), origin.pdf_direction, light.media, 0u);
     return out;
 }
 
-// Light subpaths start in the global medium (an empty stack): emitters are taken to lie outside
-// every medium an object bounds (joins, traced from the camera side, are right regardless).
-// Light from infinity crosses a homogeneous global medium of infinite extent, as the path
+// Light from infinity starts its subpath in the global medium (an empty stack; a finite emitter
+// in the media around it, media_around). It crosses a homogeneous global medium of infinite extent, as the path
 // tracer's shadow rays to it do: its transmittance is 0 in every channel that attenuates.
 fn light_media_transmittance(kind: u32) -> vec3<f32> {
     if !HAS_MEDIA || params.medium_count == 0u || (kind != EMITTER_INFINITE && kind != EMITTER_DELTA_DIRECTION) {
