@@ -103,6 +103,15 @@ medium = "slab"
     scene_in(dir, &toml).kernel_scene()
 }
 
+/// Renders `scene` at `spp` on the CPU and, where there is one, the GPU, and asserts each
+/// image's mean is `want` ([`assert_mean_is`]).
+fn assert_mean_on_each_device(name: &str, scene: &KernelScene, spp: u32, want: [f64; 3]) {
+    for (device, mut renderer) in renderers(scene) {
+        let (image, variance) = render_with_variance(renderer.as_mut(), spp);
+        assert_mean_is(&format!("{device} {name}"), &image, &variance, want);
+    }
+}
+
 /// The image's mean per channel and its z against `want`, from the variance of each pixel's
 /// mean; asserts |z| < 5 in every channel.
 fn assert_mean_is(
@@ -161,15 +170,7 @@ material = "lamp"
         },
         ..scene
     };
-    for (device, mut renderer) in renderers(&scene) {
-        let (image, variance) = render_with_variance(renderer.as_mut(), 256);
-        assert_mean_is(
-            &format!("{device} Beer slab"),
-            &image,
-            &variance,
-            sigma_a.map(|a| (-a).exp()),
-        );
-    }
+    assert_mean_on_each_device("Beer slab", &scene, 256, sigma_a.map(|a| (-a).exp()));
 }
 
 /// A sun of irradiance E = 2 shining along +z into the slab (σs = (0.3, 0.6, 1.2), σa = 0.1,
@@ -198,15 +199,7 @@ intensity = 2.0
         let t = s + 0.1;
         2.0 * s * phase_back * (1.0 - (-2.0 * t).exp()) / (2.0 * t)
     });
-    for (device, mut renderer) in renderers(&scene) {
-        let (image, variance) = render_with_variance(renderer.as_mut(), 256);
-        assert_mean_is(
-            &format!("{device} single scattering"),
-            &image,
-            &variance,
-            want,
-        );
-    }
+    assert_mean_on_each_device("single scattering", &scene, 256, want);
 }
 
 /// A unit sphere of medium `medium` behind an interface, under `sky`, seen from outside.
@@ -271,15 +264,7 @@ fn white_furnace_media_vanish_under_a_uniform_map() {
         );
         let scene = scene_in(dir.path(), &text).kernel_scene();
         assert!(scene.params.light_sampling != 0 && !scene.emitters.is_empty());
-        for (device, mut renderer) in renderers(&scene) {
-            let (image, variance) = render_with_variance(renderer.as_mut(), 64);
-            assert_mean_is(
-                &format!("{device} furnace map g = {g}"),
-                &image,
-                &variance,
-                [1.0; 3],
-            );
-        }
+        assert_mean_on_each_device(&format!("furnace map g = {g}"), &scene, 64, [1.0; 3]);
     }
 }
 
@@ -310,15 +295,7 @@ radius = 0.5
 material = "white"
 "#;
     let scene = scene_in(dir.path(), &text).kernel_scene();
-    for (device, mut renderer) in renderers(&scene) {
-        let (image, variance) = render_with_variance(renderer.as_mut(), 64);
-        assert_mean_is(
-            &format!("{device} white sphere behind an interface"),
-            &image,
-            &variance,
-            [1.0; 3],
-        );
-    }
+    assert_mean_on_each_device("white sphere behind an interface", &scene, 64, [1.0; 3]);
 }
 
 /// `subsurface_color` and `subsurface_radius` on a pbr material: a medium inside every sphere of
