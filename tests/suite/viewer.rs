@@ -144,6 +144,22 @@ fn frames(log: &[Value]) -> Vec<&Value> {
         .collect()
 }
 
+/// Each frame's samples per pixel.
+fn frame_spp(log: &[Value]) -> Vec<u64> {
+    frames(log)
+        .iter()
+        .map(|f| f["spp"].as_u64().unwrap())
+        .collect()
+}
+
+/// I (the `integrator` script word) switched once, to `integrator`, without an error.
+fn assert_switched_once_to(log: &[Value], integrator: &str) {
+    let switched = events(log, "integrator");
+    assert_eq!(switched.len(), 1, "{switched:?}");
+    assert_eq!(switched[0]["integrator"], integrator);
+    assert!(switched[0].get("error").is_none(), "{switched:?}");
+}
+
 fn events<'a>(log: &'a [Value], name: &str) -> Vec<&'a Value> {
     log.iter().filter(|l| l["event"] == name).collect()
 }
@@ -241,14 +257,8 @@ fn i_switches_to_bdpt_and_the_viewer_holds_what_render_writes() {
             "shot.exr",
         ],
     ));
-    let switched = events(&log, "integrator");
-    assert_eq!(switched.len(), 1, "{switched:?}");
-    assert_eq!(switched[0]["integrator"], "bdpt");
-    assert!(switched[0].get("error").is_none(), "{switched:?}");
-    let spp: Vec<u64> = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
+    assert_switched_once_to(&log, "bdpt");
+    let spp = frame_spp(&log);
     assert_eq!(spp, [1, 5, 1, 5, 9, 13]);
     let titles = events(&log, "title");
     assert!(
@@ -319,14 +329,8 @@ fn i_in_a_medium_switches_to_bdpt() {
         "--screenshot",
         "shot.exr",
     ]));
-    let switched = events(&log, "integrator");
-    assert_eq!(switched.len(), 1, "{switched:?}");
-    assert_eq!(switched[0]["integrator"], "bdpt");
-    assert!(switched[0].get("error").is_none(), "{switched:?}");
-    let spp: Vec<u64> = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
+    assert_switched_once_to(&log, "bdpt");
+    let spp = frame_spp(&log);
     assert_eq!(spp, [1, 1, 2, 3], "the switch restarts the accumulation");
     let shot = glint::image::output::Image::read_exr(&session.path().join("shot.exr")).unwrap();
     let mean = shot.mean();
@@ -350,10 +354,7 @@ fn a_camera_move_restarts_the_accumulation_and_exposure_does_not() {
             "3:orbit 40 0; 5:exposure 1; 6:pan 5 5; 7:dolly 1; 8:fly 0 0 0.1; 9:restart; 10:save-png",
         ],
     ));
-    let spp: Vec<u64> = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
+    let spp = frame_spp(&log);
     // 1-spp previews at the start and after each move or restart, then 2 per frame.
     assert_eq!(spp, [1, 3, 5, 1, 3, 5, 1, 1, 1, 1, 3, 5]);
     let restarted: Vec<bool> = frames(&log)
@@ -468,10 +469,7 @@ fn good_then_broken_edit(
     assert_eq!(reloads[0]["ok"].as_bool(), Some(true), "{log:?}");
     assert_eq!(reloads[1]["ok"].as_bool(), Some(false), "{log:?}");
     let error = reloads[1]["error"].as_str().unwrap().to_owned();
-    let spp = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
+    let spp = frame_spp(&log);
     (error, spp)
 }
 
@@ -535,10 +533,7 @@ fn scene_edits_on_disk_are_picked_up_and_broken_ones_keep_the_last_good_scene() 
     assert!(stderr.contains("keeping the last good scene"), "{stderr}");
     assert!(stderr.contains("radius"), "{stderr}");
 
-    let spp: Vec<u64> = frames(&log)
-        .iter()
-        .map(|f| f["spp"].as_u64().unwrap())
-        .collect();
+    let spp = frame_spp(&log);
     // The good edit restarts; the broken one changes nothing.
     assert_eq!(spp, [1, 5, 9, 1, 5, 9, 13, 17, 21, 25, 29, 33, 37, 41]);
     let png = image::open(session.path().join("shot.png"))
@@ -739,13 +734,7 @@ fn d_denoises_the_shown_image_and_the_title_says_so() {
         .iter()
         .all(|t| !t["title"].as_str().unwrap().contains("denoised")));
     // The AOVs change nothing in the accumulation: both runs reach the same samples.
-    let spp = |log: &[Value]| -> Vec<u64> {
-        frames(log)
-            .iter()
-            .map(|f| f["spp"].as_u64().unwrap())
-            .collect()
-    };
-    assert_eq!(spp(&log), spp(&raw_log));
+    assert_eq!(frame_spp(&log), frame_spp(&raw_log));
 
     // The screenshot is the denoised image of the same samples: smooth where the raw one is
     // noisy (19 spp), with the walls' colours kept.
