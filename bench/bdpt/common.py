@@ -1,22 +1,15 @@
 """What the bidirectional benchmarks share: reading an EXR, rendering once on the CPU reference
 (or, with GLINT_DEVICE=gpu, the GPU kernel) with its CPU seconds kept beside the image, and the
 relative MSE."""
-import os, resource, subprocess
-import numpy as np
-import OpenEXR, Imath
+import os, resource, subprocess, sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from exr import read_rgb as load, rel_mse  # noqa: E402,F401 (the benchmarks import them from here)
 
 GLINT = os.environ.get("GLINT", "target/release/glint")
 # "cpu" (the CPU reference) or "gpu" (the kernel; on lavapipe its threads are this process's
 # children too, so CPU seconds count them).
 DEVICE = os.environ.get("GLINT_DEVICE", "cpu")
-
-
-def load(path):
-    f = OpenEXR.InputFile(path)
-    dw = f.header()["dataWindow"]
-    w, h = dw.max.x - dw.min.x + 1, dw.max.y - dw.min.y + 1
-    pt = Imath.PixelType(Imath.PixelType.FLOAT)
-    return np.stack([np.frombuffer(f.channel(c, pt), np.float32).reshape(h, w) for c in "RGB"], -1)
 
 
 def render(scene, w, h, spp, integrator, seed, out, device=None):
@@ -35,10 +28,3 @@ def render(scene, w, h, spp, integrator, seed, out, device=None):
     open(out + ".seconds", "w").write(str(seconds))
     return seconds
 
-
-def rel_mse(img, ref, box=None):
-    """Mean of (img − ref)² / (ref² + 0.01) over the image, or over box = (x0, y0, x1, y1)."""
-    if box:
-        x0, y0, x1, y1 = box
-        img, ref = img[y0:y1, x0:x1], ref[y0:y1, x0:x1]
-    return float(np.mean((img - ref) ** 2 / (ref ** 2 + 1e-2)))

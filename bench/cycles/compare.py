@@ -3,15 +3,10 @@
 # highlights (rows 64-96, columns 112-144 at 256x256: a few pixels of a lamp's reflection
 # reach hundreds there and dominate both images' means), and the means of given regions.
 # Usage: compare.py GLINT.exr CYCLES.exr SIDE.png [x0,y0,x1,y1 ...]
-import sys, numpy as np, OpenEXR
+import os, sys, numpy as np
 import imageio.v3 as iio
-def read(path):
-    f = OpenEXR.File(path)
-    ch = f.channels()
-    if "RGBA" in ch or "RGB" in ch:
-        px = ch.get("RGBA", ch.get("RGB")).pixels
-        return np.asarray(px, dtype=np.float64)[..., :3]
-    return np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in "RGB"], axis=-1)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from exr import read_rgb as read
 def srgb(x):
     x = np.clip(x, 0, 1)
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)

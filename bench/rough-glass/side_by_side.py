@@ -7,24 +7,15 @@ sRGB-encoded and clipped. Prints each sphere's mean over the pixels its mask cov
 
 Needs `pip install OpenEXR numpy`."""
 
+import os
 import struct
 import sys
 import zlib
 
 import numpy as np
-import OpenEXR
 
-
-def read_rgb(path):
-    channels = OpenEXR.File(path).channels()
-    for packed in ("RGBA", "RGB"):
-        if packed in channels:
-            return channels[packed].pixels[..., :3].astype(np.float64)
-
-    def channel(name):
-        return next(c.pixels for k, c in channels.items() if k == name or k.endswith("." + name))
-
-    return np.stack([channel(n) for n in "RGB"], -1).astype(np.float64)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from exr import read_rgb  # noqa: E402
 
 
 def srgb(linear):

@@ -30,24 +30,12 @@ import sys
 import time
 
 import numpy as np
-import OpenEXR
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from exr import read_rgb as read_exr, rel_mse  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RENDERERS = ["glint-cpu", "glint-lavapipe", "cycles", "mitsuba"]
-
-
-def read_exr(path):
-    f = OpenEXR.File(path)
-    ch = f.channels()
-    if "RGBA" in ch or "RGB" in ch:
-        px = ch.get("RGBA", ch.get("RGB")).pixels
-        return np.asarray(px, dtype=np.float64)[..., :3]
-    return np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in "RGB"], axis=-1)
-
-
-def rel_mse(image, ref):
-    """glint compare's relative MSE: mean of (A - B)^2 / (B^2 + 0.01)."""
-    return float(np.mean((image - ref) ** 2 / (ref ** 2 + 0.01)))
 
 
 def children_cpu():

@@ -3,20 +3,13 @@
 # film transparent, as cycles_render.py does), in the Cycles image and in each other image, and
 # their ratios to Cycles'.
 # Usage: python3 means.py [--row] CYCLES.exr OTHER.exr ...   (needs numpy and OpenEXR)
+import os
 import sys
 
 import numpy as np
-import OpenEXR
 
-
-def read(path):
-    ch = OpenEXR.File(path).channels()
-    for name in ("RGBA", "RGB"):
-        if name in ch:
-            px = np.asarray(ch[name].pixels, dtype=np.float64)
-            return px[..., :3], (px[..., 3] if px.shape[-1] == 4 else None)
-    get = lambda c: np.asarray(ch[c].pixels, dtype=np.float64) if c in ch else None
-    return np.stack([get(c) for c in "RGB"], -1), get("A")
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib"))
+from exr import read_rgba as read  # noqa: E402
 
 
 args = sys.argv[1:]
