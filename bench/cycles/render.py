@@ -3,7 +3,9 @@
 # environment map turned to glint's orientation, the same bounces, a near-box pixel filter,
 # linear EXR out. Usage: blender -b --python render.py -- MODEL ENV OUT.exr SIZE SPP EYE_Z VFOV
 # [EYE_X EYE_Y] (the eye moved across, still looking along −z: glint's target (EYE_X, EYE_Y, 0))
-import bpy, math, sys
+import bpy, math, os, sys
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from cycles_world import glint_world
 import numpy
 # Debian 12 Blender 3.4 glTF importer uses np.bool, which newer NumPy removed.
 if not hasattr(numpy, "bool") or numpy.bool is not bool:
@@ -23,22 +25,7 @@ cam.location = (eye_x, -eye_z, eye_y)
 cam.rotation_euler = (math.radians(90.0), 0.0, 0.0)
 scene.collection.objects.link(cam)
 scene.camera = cam
-world = bpy.data.worlds.new("world")
-world.use_nodes = True
-scene.world = world
-nodes, links = world.node_tree.nodes, world.node_tree.links
-background = nodes["Background"]
-texture = nodes.new("ShaderNodeTexEnvironment")
-texture.image = bpy.data.images.load(env)
-texture.interpolation = 'Closest'  # glint reads the nearest texel
-coords = nodes.new("ShaderNodeTexCoord")
-mapping = nodes.new("ShaderNodeMapping")
-# glint reads u = atan2(x, -z) / 2π (glTF frame); Cycles u = (π − atan2(y, x)) / 2π (its frame)
-# is glint's + 0.25 there: turn the lookup direction +90° about +Z.
-mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(90.0))
-links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
-links.new(texture.outputs["Color"], background.inputs["Color"])
+glint_world(scene, environment=env)
 scene.render.engine = 'CYCLES'
 cycles = scene.cycles
 cycles.device = 'CPU'

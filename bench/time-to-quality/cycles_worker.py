@@ -11,7 +11,8 @@
 # segments, smooth shaded: Cycles has no analytic sphere here), PLY meshes with glint's
 # transform (translate . Rz . Ry . Rx . scale), diffuse, specular (a sharp Glossy BSDF),
 # emission x strength (Cycles' mesh emission is two-sided, as glint's), the background colour,
-# and a glTF mesh with an environment map (the helmet: as ../cycles/render.py does it).
+# and a glTF mesh with an environment map (the helmet: as ../cycles/render.py does it,
+# with ../lib/cycles_world.py).
 # glint's frame (x, y, z) is Blender's (x, -z, y).
 import json
 import math
@@ -23,6 +24,9 @@ import tomllib
 
 import bpy
 from mathutils import Matrix, Vector
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "lib"))
+from cycles_world import glint_world  # noqa: E402
 
 scene_path, prefix, size, seed, threads = sys.argv[1:6]
 size, seed, threads = int(size), int(seed), int(threads)
@@ -149,25 +153,10 @@ cam_obj.rotation_euler = (target - eye).to_track_quat("-Z", "Y").to_euler()
 scene.collection.objects.link(cam_obj)
 scene.camera = cam_obj
 
-world = bpy.data.worlds.new("world")
-world.use_nodes = True
-scene.world = world
-nodes, links = world.node_tree.nodes, world.node_tree.links
-background = nodes["Background"]
 if "environment" in toml:
-    texture = nodes.new("ShaderNodeTexEnvironment")
-    texture.image = bpy.data.images.load(resolve(toml["environment"]["file"]))
-    texture.interpolation = "Closest"  # glint reads the nearest texel
-    coords = nodes.new("ShaderNodeTexCoord")
-    mapping = nodes.new("ShaderNodeMapping")
-    # as ../cycles/render.py: glint's u = atan2(x, -z)/2pi is Cycles' + 0.25
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(90.0))
-    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-    links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
-    links.new(texture.outputs["Color"], background.inputs["Color"])
+    glint_world(scene, environment=resolve(toml["environment"]["file"]))
 else:
-    bg = toml.get("render", {}).get("background", [0.0, 0.0, 0.0])
-    background.inputs["Color"].default_value = (*bg, 1.0)
+    glint_world(scene, color=toml.get("render", {}).get("background", [0.0, 0.0, 0.0]))
 
 bounces = toml.get("render", {}).get("max_bounces", 8)
 scene.render.engine = "CYCLES"

@@ -1,11 +1,14 @@
 # Renders a .glb with Cycles 4.5 (CPU, no denoiser, no adaptive sampling, no clamping,
 # Standard view, linear EXR; the file's camera; film transparent so alpha is the coverage).
-# The environment map is turned to glint's orientation and read nearest-texel, as in
-# ../render.py. Usage: python3.11 cycles_render.py IN.glb OUT.exr W H SPP (const:V | HDR_PATH) [BOUNCES]
-import math
+# The environment map is turned to glint's orientation and read nearest-texel
+# (../../lib/cycles_world.py). Usage: python3.11 cycles_render.py IN.glb OUT.exr W H SPP (const:V | HDR_PATH) [BOUNCES]
+import os
 import sys
 
 import bpy
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "lib"))
+from cycles_world import glint_world  # noqa: E402
 
 glb, out, w, h, spp, sky = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]), sys.argv[6]
 bounces = int(sys.argv[7]) if len(sys.argv) > 7 else 8
@@ -14,25 +17,10 @@ bpy.ops.import_scene.gltf(filepath=glb)
 scene = bpy.context.scene
 cams = [o for o in scene.objects if o.type == "CAMERA"]
 scene.camera = cams[0]
-world = bpy.data.worlds.new("world")
-world.use_nodes = True
-scene.world = world
-nodes, links = world.node_tree.nodes, world.node_tree.links
-bg = nodes["Background"]
 if sky.startswith("const:"):
-    v = float(sky[6:])
-    bg.inputs["Color"].default_value = (v, v, v, 1.0)
+    glint_world(scene, color=(float(sky[6:]),) * 3)
 else:
-    tex = nodes.new("ShaderNodeTexEnvironment")
-    tex.image = bpy.data.images.load(sky)
-    tex.interpolation = "Closest"  # glint reads the nearest texel
-    coords = nodes.new("ShaderNodeTexCoord")
-    mapping = nodes.new("ShaderNodeMapping")
-    # as bench/cycles/render.py: glint's u = atan2(x, -z)/2pi is Cycles' + 0.25
-    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(90.0))
-    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
-    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
-    links.new(tex.outputs["Color"], bg.inputs["Color"])
+    glint_world(scene, environment=sky)
 scene.render.engine = "CYCLES"
 c = scene.cycles
 c.device = "CPU"
