@@ -58,14 +58,7 @@ fn diffuse_fog(seed: u32) -> KernelScene {
 
 fn diffuse_fog_at(size: u32, seed: u32) -> KernelScene {
     let text = fog_text(2);
-    let text = text[..text.find("# The spot").unwrap()]
-        .replace("type = \"specular\"", "type = \"diffuse\"")
-        .replace(
-            "corner = [343.0, 554.0, 332.0]",
-            "corner = [443.0, 554.0, 432.0]",
-        )
-        .replace("u = [-130.0, 0.0, 0.0]", "u = [-330.0, 0.0, 0.0]")
-        .replace("v = [0.0, 0.0, -105.0]", "v = [0.0, 0.0, -305.0]");
+    let text = common::all_diffuse_with_a_larger_light(&text[..text.find("# The spot").unwrap()]);
     sized(&text, size, seed)
 }
 

@@ -343,19 +343,24 @@ pub fn glint_ok(dir: &Path, args: &[&str]) -> Output {
     out
 }
 
-/// The Cornell box all diffuse (the mirror sphere matte: a delta vertex would rule strategies
-/// out) with a larger light (so that BSDF sampling finds it often enough to test), rendered
-/// bidirectionally with two bounces, at `size`² and `seed`: light tracing's splats carry much
-/// of the light, and no sample is a firefly.
-pub fn bdpt_diffuse_box(size: u32, seed: u32) -> KernelScene {
-    let text = shipped_scene_text("cornell.toml")
-        .replace("type = \"specular\"", "type = \"diffuse\"")
+/// A Cornell box's scene text (scenes/cornell.toml's, or a variant of it) with its mirror matte
+/// and its ceiling light grown from 130 × 105 to 330 × 305 (centred as before).
+pub fn all_diffuse_with_a_larger_light(text: &str) -> String {
+    text.replace("type = \"specular\"", "type = \"diffuse\"")
         .replace(
             "corner = [343.0, 554.0, 332.0]",
             "corner = [443.0, 554.0, 432.0]",
         )
         .replace("u = [-130.0, 0.0, 0.0]", "u = [-330.0, 0.0, 0.0]")
-        .replace("v = [0.0, 0.0, -105.0]", "v = [0.0, 0.0, -305.0]");
+        .replace("v = [0.0, 0.0, -105.0]", "v = [0.0, 0.0, -305.0]")
+}
+
+/// The Cornell box all diffuse (the mirror sphere matte: a delta vertex would rule strategies
+/// out) with a larger light (so that BSDF sampling finds it often enough to test), rendered
+/// bidirectionally with two bounces, at `size`² and `seed`: light tracing's splats carry much
+/// of the light, and no sample is a firefly.
+pub fn bdpt_diffuse_box(size: u32, seed: u32) -> KernelScene {
+    let text = all_diffuse_with_a_larger_light(&shipped_scene_text("cornell.toml"));
     let mut scene = sized(self::scene(&text), size, seed);
     scene.params.integrator = glint::kernel::types::INTEGRATOR_BDPT;
     scene.params.max_bounces = 2;
