@@ -37,22 +37,38 @@ fn keyed_connection(id: SampleId, s: u32, t: u32) {
 // ray from just off the first towards just off the second.
 fn segment_clear(a: BdptVertex, b: BdptVertex, id: SampleId, s: u32, t: u32) -> bool {
     keyed_connection(id, s, t);
-    let dir = direction_between(a, b);
-    let start = off_surface(a, dir);
+    let join = join_ray(a, b, direction_between(a, b));
     if is_infinite(b) {
-        return escapes(Ray(start, dir));
+        return escapes(join.ray);
     }
-    let end = off_surface(b, -dir);
-    let to_end = end - start;
-    let distance = length(to_end);
-    if distance <= 0.0 {
+    if join.distance <= 0.0 {
         return false;
     }
     // Short of the far end by a sliver, as pbrt's SpawnRayTo: where a surface's point is exact
     // along its normal (an axis-aligned quad), its error bound and so its offset are 0, and
     // whether the ray meets that surface just before or just after `distance` is down to
     // rounding.
-    return unoccluded_before(Ray(start, to_end / distance), distance * (1.0 - SHADOW_EPSILON));
+    return unoccluded_before(join.ray, join.distance * (1.0 - SHADOW_EPSILON));
+}
+
+// A join's shadow ray, from just off vertex a along dir (direction_between(a, b)): towards
+// infinity where b is there, else towards end_point, just off b, distance away (0 where the
+// two points meet: no join).
+struct JoinRay {
+    ray: Ray,
+    end_point: vec3<f32>,
+    distance: f32,
+}
+
+fn join_ray(a: BdptVertex, b: BdptVertex, dir: vec3<f32>) -> JoinRay {
+    let start = off_surface(a, dir);
+    if is_infinite(b) {
+        return JoinRay(Ray(start, dir), start, 0.0);
+    }
+    let end_point = off_surface(b, -dir);
+    let to_end = end_point - start;
+    let distance = length(to_end);
+    return JoinRay(Ray(start, to_end / distance), end_point, distance);
 }
 
 // The fraction of the light that gets from camera-side vertex `a` to vertex `b` (one may be at
@@ -66,23 +82,18 @@ fn segment_through(a: BdptVertex, b: BdptVertex, id: SampleId, s: u32, t: u32) -
     }
     keyed_connection(id, s, t);
     let dir = direction_between(a, b);
-    let start = off_surface(a, dir);
+    let join = join_ray(a, b, dir);
     let media = stack_towards(a, dir);
     // To infinity: a join ends where the ray escapes, as a shadow ray to the sky does.
-    var ray = Ray(start, dir);
     var end = RayEnd(PRIMITIVE_ENVIRONMENT, 0u, vec3<f32>(0.0), 0.0);
     if !is_infinite(b) {
-        let end_point = off_surface(b, -dir);
-        let to_end = end_point - start;
-        let distance = length(to_end);
-        if distance <= 0.0 {
+        if join.distance <= 0.0 {
             return vec3<f32>(0.0);
         }
-        ray = Ray(start, to_end / distance);
         // As segment_clear: short of the far end by a sliver of the join's length.
-        end = RayEnd(RAY_END_POINT, 0u, end_point, distance * SHADOW_EPSILON);
+        end = RayEnd(RAY_END_POINT, 0u, join.end_point, join.distance * SHADOW_EPSILON);
     }
-    return transmittance_along(ray, media, end, id.pixel, id.sample, CONNECTION_TRACKING + s * 32u + t, false);
+    return transmittance_along(join.ray, media, end, id.pixel, id.sample, CONNECTION_TRACKING + s * 32u + t, false);
 }
 
 // The media a ray from vertex v along dir starts in: the vertex's, crossed into the medium its

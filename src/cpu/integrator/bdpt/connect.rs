@@ -66,26 +66,49 @@ pub fn segment_clear(
 ) -> bool {
     let scene = keyed_connection(scene, id, s, t);
     let geometry = &scene.geometry;
-    let dir = direction_between(a, b);
-    let start = off_surface(a, dir);
+    let join = join_ray(a, b, direction_between(a, b));
     if b.is_infinite() {
-        return escapes(geometry, &Ray { origin: start, dir });
+        return escapes(geometry, &join.ray);
     }
-    let end = off_surface(b, -dir);
-    let to_end = end - start;
-    let distance = to_end.length();
-    if distance <= 0.0 {
+    if join.distance <= 0.0 {
         return false;
     }
-    let ray = Ray {
-        origin: start,
-        dir: to_end / distance,
-    };
     // Short of the far end by a sliver, as pbrt's `SpawnRayTo`: where a surface's point is
     // exact along its normal (an axis-aligned quad), its error bound and so its offset are 0,
     // and whether the ray meets that surface just before or just after `distance` is down to
     // rounding (measured: 4.5% of the joins from a wall to the floor were lost so).
-    unoccluded_before(geometry, &ray, distance * (1.0 - SHADOW_EPSILON))
+    unoccluded_before(geometry, &join.ray, join.distance * (1.0 - SHADOW_EPSILON))
+}
+
+/// A join's shadow ray, from just off vertex `a` along `dir` (`direction_between(a, b)`):
+/// towards infinity where `b` is there, else towards `end_point`, just off `b`, `distance`
+/// away (0 where the two points meet: no join).
+struct JoinRay {
+    ray: Ray,
+    end_point: Vec3,
+    distance: f32,
+}
+
+fn join_ray(a: &BdptVertex, b: &BdptVertex, dir: Vec3) -> JoinRay {
+    let start = off_surface(a, dir);
+    if b.is_infinite() {
+        return JoinRay {
+            ray: Ray { origin: start, dir },
+            end_point: start,
+            distance: 0.0,
+        };
+    }
+    let end_point = off_surface(b, -dir);
+    let to_end = end_point - start;
+    let distance = to_end.length();
+    JoinRay {
+        ray: Ray {
+            origin: start,
+            dir: to_end / distance,
+        },
+        end_point,
+        distance,
+    }
 }
 
 /// The fraction of the light that gets from camera-side vertex `a` to vertex `b` (one may be
@@ -110,7 +133,7 @@ pub fn segment_through(
     }
     let scene = keyed_connection(scene, id, s, t);
     let dir = direction_between(a, b);
-    let start = off_surface(a, dir);
+    let join = join_ray(a, b, dir);
     let media = stack_towards(scene.params, a, dir);
     let tracking = TrackingStream {
         pixel: id.pixel,
@@ -119,20 +142,13 @@ pub fn segment_through(
     };
     let mut unused = 0;
     if b.is_infinite() {
-        let ray = Ray { origin: start, dir };
         let end = |_: &Ray, hit: &Hit| if hit.t == NO_HIT { NO_HIT } else { -1.0 };
-        return transmittance_along(&scene, &ray, &media, &mut unused, tracking, end);
+        return transmittance_along(&scene, &join.ray, &media, &mut unused, tracking, end);
     }
-    let end_point = off_surface(b, -dir);
-    let to_end = end_point - start;
-    let distance = to_end.length();
-    if distance <= 0.0 {
+    if join.distance <= 0.0 {
         return Vec3::ZERO;
     }
-    let ray = Ray {
-        origin: start,
-        dir: to_end / distance,
-    };
+    let (end_point, distance) = (join.end_point, join.distance);
     // As `segment_clear`: short of the far end by a sliver of the join's length.
     let end = |piece: &Ray, hit: &Hit| {
         let t_end = (end_point - piece.origin).dot(piece.dir).max(0.0);
@@ -142,7 +158,7 @@ pub fn segment_through(
             -1.0
         }
     };
-    transmittance_along(&scene, &ray, &media, &mut unused, tracking, end)
+    transmittance_along(&scene, &join.ray, &media, &mut unused, tracking, end)
 }
 
 /// The media a ray from vertex `v` along `dir` starts in: the vertex's, crossed into the
