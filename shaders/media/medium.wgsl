@@ -202,6 +202,11 @@ fn shadow_transmittance(shadow: Ray, light: LightSample, stack: MediumStack, pix
 // from p out of the scene, through every surface, leaves each of them through a back face it
 // did not enter on the way (up to MAX_SURROUNDING_SURFACES surfaces).
 fn media_around(p: vec3<f32>) -> MediumStack {
+    // Slots of media that objects bound come first: without one, nothing encloses p (a global
+    // fog), and the walk's rays are spared.
+    if params.medium_count == 0u || params.media[0].boundary == NO_MEDIUM {
+        return MediumStack();
+    }
     var ray = Ray(p, SURROUNDINGS_DIRECTION);
     // Media entered on the way out (objects beside p, not around it), and those left.
     var entered = MediumStack();

@@ -133,6 +133,11 @@ const SURROUNDINGS_DIRECTION: Vec3 = Vec3::new(0.267_261_24, 0.801_783_7, 0.534_
 /// subpath learns the medium it starts in.
 pub fn media_around(scene: &SceneRefs, p: Vec3) -> MediumStack {
     let params = scene.params;
+    // Slots of media that objects bound come first: without one, nothing encloses `p` (a
+    // global fog), and the walk's rays are spared.
+    if params.medium_count == 0 || params.media[0].boundary == NO_MEDIUM {
+        return MediumStack::default();
+    }
     let mut ray = Ray {
         origin: p,
         dir: SURROUNDINGS_DIRECTION,
